@@ -1,0 +1,161 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+using Triangle = std::array<int, 3>;
+
+/** \brief A triangle complex with its edges and incidences, as flat arrays.
+ *
+ * Stages 5-7 (umbrella check, pruning, walk) work on the candidate triangles
+ * through this structure. Every triangle incident to an edge carries its angle about
+ * the edge, which gives the circular order around the edge.
+ */
+class TriangleComplex {
+public:
+  /** \param[in] points vertex positions
+   *  \param[in] triangles the triangles (any vertex order; duplicates not allowed) */
+  TriangleComplex(const std::vector<Eigen::Vector3d>& points,
+                  std::vector<Triangle> triangles);
+
+  std::size_t
+  numTriangles() const
+  {
+    return triangles_.size();
+  }
+
+  std::size_t
+  numEdges() const
+  {
+    return edges_.size();
+  }
+
+  const std::vector<Eigen::Vector3d>&
+  points() const
+  {
+    return points_;
+  }
+
+  /** Vertex ids of triangle t, ascending. */
+  const Triangle&
+  triangle(int t) const
+  {
+    return triangles_[t];
+  }
+
+  /** Edge ids of triangle t; edge k is opposite vertex k. */
+  const std::array<int, 3>&
+  triangleEdges(int t) const
+  {
+    return triangle_edges_[t];
+  }
+
+  /** End points of edge e, ascending. */
+  const std::array<int, 2>&
+  edge(int e) const
+  {
+    return edges_[e];
+  }
+
+  /** Range [first, last) of incidences of edge e in edgeTriangle() / edgeAngle(). */
+  std::size_t
+  edgeBegin(int e) const
+  {
+    return edge_first_[e];
+  }
+
+  std::size_t
+  edgeEnd(int e) const
+  {
+    return edge_first_[e + 1];
+  }
+
+  /** Triangle of incidence i. */
+  int
+  edgeTriangle(std::size_t i) const
+  {
+    return edge_triangles_[i];
+  }
+
+  /** Angle of the triangle of incidence i about its edge, in [-pi, pi]. */
+  double
+  edgeAngle(std::size_t i) const
+  {
+    return edge_angles_[i];
+  }
+
+  /** Range of triangles incident to vertex v in vertexTriangle(). */
+  std::size_t
+  vertexBegin(int v) const
+  {
+    return vertex_first_[v];
+  }
+
+  std::size_t
+  vertexEnd(int v) const
+  {
+    return vertex_first_[v + 1];
+  }
+
+  int
+  vertexTriangle(std::size_t i) const
+  {
+    return vertex_triangles_[i];
+  }
+
+  /** The edge of triangle t joining vertices a and b, -1 if none. */
+  int
+  edgeOf(int t, int a, int b) const;
+
+  /** ISSHARP: edge e is sharp among the triangles for which alive(t) is true if it has
+   * exactly one, or two consecutive ones (in circular order) with an angular gap of
+   * more than 3 pi / 2 between them. No triangle: not sharp. */
+  template <typename Alive>
+  bool
+  isSharp(int e, const Alive& alive) const;
+
+private:
+  const std::vector<Eigen::Vector3d>& points_;
+  std::vector<Triangle> triangles_;
+  std::vector<std::array<int, 3>> triangle_edges_;
+  std::vector<std::array<int, 2>> edges_;
+  std::vector<std::size_t> edge_first_;
+  std::vector<int> edge_triangles_;
+  std::vector<double> edge_angles_;
+  std::vector<std::size_t> vertex_first_;
+  std::vector<int> vertex_triangles_;
+};
+
+/** \brief Largest circular gap between angles (radians); sorts \a angles. */
+double
+largestAngularGap(std::vector<double>& angles);
+
+template <typename Alive>
+bool
+TriangleComplex::isSharp(int e, const Alive& alive) const
+{
+  thread_local std::vector<double> angles;
+  angles.clear();
+  for (std::size_t i = edgeBegin(e); i < edgeEnd(e); ++i)
+    if (alive(edge_triangles_[i]))
+      angles.push_back(edge_angles_[i]);
+  if (angles.empty())
+    return false;
+  if (angles.size() == 1)
+    return true;
+  return largestAngularGap(angles) > 1.5 * 3.14159265358979323846;
+}
+
+} // namespace cocone
+} // namespace pcl

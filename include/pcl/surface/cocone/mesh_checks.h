@@ -1,0 +1,85 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/complex.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief Edges of an oriented triangle list grouped by their end points.
+ *
+ * Incidence i of edge e says which triangle uses the edge and whether it traverses
+ * it from the lower to the higher vertex id.
+ */
+struct EdgeIncidences {
+  std::vector<std::array<int, 2>> edges;       // end points, ascending
+  std::vector<std::size_t> first;              // CSR offsets, size edges + 1
+  std::vector<int> triangle;                   // per incidence
+  std::vector<std::uint8_t> forward;           // per incidence: traverses lower -> higher
+
+  explicit EdgeIncidences(const std::vector<Triangle>& oriented);
+
+  std::size_t
+  count(std::size_t e) const
+  {
+    return first[e + 1] - first[e];
+  }
+};
+
+/** \brief Per vertex, the fans of its star: groups of triangles connected through
+ * edges at the vertex. A 2-manifold has one fan per vertex.
+ *
+ * \return per triangle corner (3 t + k): the fan id of vertex oriented[t][k] that the
+ *         triangle belongs to, numbered from 0 per vertex
+ */
+std::vector<int>
+vertexFans(const std::vector<Triangle>& oriented,
+           std::size_t num_vertices,
+           std::vector<int>* fans_per_vertex = nullptr);
+
+/** \brief Topology of an oriented triangle mesh. */
+struct MeshTopology {
+  std::size_t vertices = 0; // vertices used by a triangle
+  std::size_t edges = 0;
+  std::size_t triangles = 0;
+  std::size_t boundary_edges = 0;
+  std::size_t nonmanifold_edges = 0;     // in more than two triangles
+  std::size_t nonmanifold_vertices = 0;  // more than one fan
+  std::size_t orientation_conflicts = 0; // edges traversed twice the same way
+  std::size_t components = 0;            // through shared edges
+  std::size_t closed_components = 0;     // components without boundary edges
+  long euler = 0;                        // V - E + F
+
+  /** Valid oriented 2-manifold with boundary. */
+  bool
+  manifold() const
+  {
+    return nonmanifold_edges == 0 && nonmanifold_vertices == 0 &&
+           orientation_conflicts == 0;
+  }
+};
+
+/** \brief Count the topology of an oriented triangle mesh. */
+MeshTopology
+analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices);
+
+/** \brief The borders of an oriented 2-manifold mesh as closed vertex loops, each
+ * traversed with the mesh on its left, starting at its lowest vertex id; loops are
+ * sorted by that vertex. */
+std::vector<std::vector<int>>
+boundaryLoops(const std::vector<Triangle>& oriented, std::size_t num_vertices);
+
+/** \brief Component id of every triangle (through shared edges), numbered in order
+ * of the lowest triangle of each component. */
+std::vector<int>
+triangleComponents(const std::vector<Triangle>& oriented, std::size_t* count = nullptr);
+
+} // namespace cocone
+} // namespace pcl

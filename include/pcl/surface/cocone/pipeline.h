@@ -1,0 +1,113 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/candidates.h>
+#include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/repair.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief Parameters of the whole pipeline. */
+struct Parameters {
+  /** Ratio rho of the flatness test. */
+  double ratio = 1.5;
+  /** Normal angle theta in radians. */
+  double normal_angle = 0.5235987755982988; // pi / 6
+  /** Co-cone angle in radians. */
+  double cocone_angle = 1.1780972450961724; // 3 pi / 8
+  /** false: every vertex counts as interior (the original Co-cone). */
+  bool boundary_detection = true;
+  /** Which triangles the interior vertices choose (stage 4). */
+  CandidateRule candidate_rule = CandidateRule::INTERIOR_CHOOSES;
+  /** Close border loops of three edges that are one missing Delaunay triangle. */
+  bool fill_triangle_holes = true;
+};
+
+/** \brief Sizes of the intermediate results of stages 4-7. */
+struct ReconstructionCounts {
+  std::size_t candidates = 0;     // stage 4
+  std::size_t umbrella_failures = 0; // stage 5
+  std::size_t pruned = 0;         // stage 6: triangles removed
+  std::size_t walk_components = 0; // stage 7: components of the pruned complex
+  std::size_t walked = 0;         // stage 7: triangles the walk kept
+  std::size_t walk_conflicts = 0; // stage 7: triangles reached with both orientations
+  RepairCounts repair;            // changes by the manifold repair
+};
+
+/** \brief Wall-clock time of each stage, in milliseconds. */
+struct Timings {
+  double unique = 0.0;
+  double delaunay = 0.0;
+  double voronoi = 0.0;
+  double boundary = 0.0;
+  double reconstruction = 0.0;
+};
+
+/** \brief What the pipeline returns.
+ *
+ * Vertex-level fields are indexed by Delaunay vertex id; the *_indices fields hold
+ * the caller's ids of the points (see run()).
+ */
+struct Result {
+  /** Empty on success; otherwise why there is no result. */
+  std::string error;
+  /** Per point passed to run(): its Delaunay vertex, -1 if the point is not finite. */
+  std::vector<int> vertex_of_input;
+  /** Number of Delaunay vertices (unique finite points). */
+  std::size_t vertices = 0;
+  /** Per vertex: undersampled (not in the interior set of stage 3). */
+  std::vector<std::uint8_t> boundary;
+  /** Per vertex: failed the umbrella check (stage 5). */
+  std::vector<std::uint8_t> umbrella_failed;
+  /** Caller ids of the points labelled boundary (B, plus the umbrella failures after
+   * a reconstruction), ascending. Every duplicate of a boundary vertex is listed. */
+  std::vector<int> boundary_indices;
+  /** Per vertex: the caller id that stands for it in polygons (its lowest). */
+  std::vector<int> representative;
+  /** Vertex positions (recentred) and the offset to add back. */
+  std::vector<Eigen::Vector3d> positions;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  /** The output mesh: oriented triangles over vertex ids. */
+  std::vector<Triangle> triangles;
+  /** The mesh's triangles over caller ids. */
+  std::vector<Triangle> polygons;
+  /** Borders of the mesh as closed loops of caller ids. */
+  std::vector<std::vector<int>> border_loops;
+  /** Per vertex: unit pole direction turned to agree with the mesh; NaN when the
+   * vertex is not in the mesh. */
+  std::vector<Eigen::Vector3d> normals;
+  ReconstructionCounts counts;
+  Timings timings;
+};
+
+/** \brief Which stages to run. */
+enum class Stages { BOUNDARY_DETECTION, RECONSTRUCTION };
+
+/** \brief Run the stages on a set of points.
+ *
+ * \param[in] points the points; non-finite points and duplicates are allowed
+ * \param[in] parameters the parameters
+ * \param[in] stages how far to go
+ * \param[in] ids the caller's id of each point (e.g. its index in a PCL cloud);
+ *            empty: the position in \a points
+ */
+Result
+run(const std::vector<Eigen::Vector3d>& points,
+    const Parameters& parameters,
+    Stages stages,
+    const std::vector<int>& ids = {});
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,101 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/triangulation.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief A Delaunay triangle whose dual Voronoi edge meets the co-cone of at least
+ * one of its vertices.
+ *
+ * Only these triangles matter later: the co-cone neighbours (stage 3) and the
+ * candidate triangles (stage 4) are read off them.
+ */
+struct CoconeTriangle {
+  /** Vertex ids, ascending. */
+  std::array<int, 3> v;
+  /** Bit k set: the co-cone of v[k] meets the dual Voronoi edge. */
+  std::uint8_t meets;
+};
+
+/** \brief Stage 2: the geometry of every Voronoi cell V_p (Dey & Giesen, section 2.3).
+ *
+ * All arrays are indexed by vertex id.
+ */
+struct VoronoiCells {
+  /** Unit direction of the pole vector v+ - p. For a vertex on the convex hull (V_p
+   * unbounded) the normalised sum of the outward normals of its hull facets. */
+  std::vector<Eigen::Vector3d> pole;
+  /** h+ = |v+ - p|; infinite on the convex hull. */
+  std::vector<double> height_plus;
+  /** h- = |v- - p|, v- the farthest Voronoi vertex of V_p on the other side of p
+   * from v+; infinite if an unbounded edge of V_p goes that way, 0 if none does. */
+  std::vector<double> height_minus;
+  /** Co-cone width w = max |py| over y in C_p; infinite if C_p is unbounded or empty. */
+  std::vector<double> width;
+  /** Per vertex: on the convex hull. */
+  std::vector<std::uint8_t> on_hull;
+  /** The Delaunay triangles whose dual edge meets a co-cone, sorted by vertex ids. */
+  std::vector<CoconeTriangle> triangles;
+
+  /** Height h = min(h+, h-). */
+  double
+  height(int v) const
+  {
+    return std::min(height_plus[v], height_minus[v]);
+  }
+};
+
+/** \brief Result of intersecting one Voronoi edge with one co-cone. */
+struct CoconeHit {
+  /** The edge has a point in the co-cone. */
+  bool meets = false;
+  /** Largest distance from p over that part of the edge; infinite when a ray stays
+   * in the co-cone; -infinity when the edge misses it. */
+  double max_distance = -std::numeric_limits<double>::infinity();
+};
+
+/** \brief Exact edge/co-cone test.
+ *
+ * The co-cone of p is {y : |cos angle(y - p, pole)| <= cos_angle}. Along the edge
+ * y(t) = a + t d, with t in [0, 1] for a segment and t in [0, inf) for a ray, the
+ * condition is a quadratic inequality in t, solved here: an edge may cross the
+ * co-cone between two end points that both lie outside it.
+ *
+ * \param[in] p the sample point
+ * \param[in] pole unit pole direction of p
+ * \param[in] cos_angle cosine of the co-cone angle (cos(3 pi / 8) by default)
+ * \param[in] a start of the edge
+ * \param[in] d direction (segment: the vector to the end point)
+ * \param[in] ray the edge is a ray
+ */
+CoconeHit
+intersectCocone(const Eigen::Vector3d& p,
+                const Eigen::Vector3d& pole,
+                double cos_angle,
+                const Eigen::Vector3d& a,
+                const Eigen::Vector3d& d,
+                bool ray);
+
+/** \brief Compute poles, heights, widths and the co-cone triangles (stage 2).
+ *
+ * \param[in] dt the triangulation (dimension 2 or 3)
+ * \param[in] cocone_angle the co-cone angle in radians (3 pi / 8 in the paper)
+ */
+VoronoiCells
+computeVoronoiCells(const Triangulation& dt, double cocone_angle);
+
+} // namespace cocone
+} // namespace pcl

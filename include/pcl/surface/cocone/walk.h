@@ -1,0 +1,57 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/complex.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief What the walk produced. */
+struct WalkResult {
+  /** Oriented triangles (vertex ids), in the order the walk reached them. */
+  std::vector<Triangle> triangles;
+  /** Connected components of the pruned complex (one walk each). */
+  std::size_t components = 0;
+  /** Triangles reached again through another edge with the opposite orientation. */
+  std::size_t conflicts = 0;
+};
+
+/** \brief SURFACENEIGHBOR: the triangle to continue with across edge x->y of the
+ * oriented triangle (x, y, z).
+ *
+ * Among the present triangles at the edge whose normals, oriented consistently with
+ * (x, y, z), make an angle below pi / 2 with its normal, the first one met rotating
+ * about the edge from the side its normal points to.
+ *
+ * \return the triangle id, or -1; \a apex receives its third vertex
+ */
+int
+surfaceNeighbor(const TriangleComplex& complex,
+                const std::vector<std::uint8_t>& present,
+                int t,
+                int x,
+                int y,
+                int z,
+                int& apex);
+
+/** \brief Stage 7: WALK, started once in every connected component of the pruned
+ * complex, from a triangle whose vertices all have umbrellas where possible.
+ *
+ * \param[in] complex the candidate triangles
+ * \param[in] present per triangle: survived pruning
+ * \param[in] boundary per vertex: B plus the umbrella failures
+ */
+WalkResult
+walk(const TriangleComplex& complex,
+     const std::vector<std::uint8_t>& present,
+     const std::vector<std::uint8_t>& boundary);
+
+} // namespace cocone
+} // namespace pcl

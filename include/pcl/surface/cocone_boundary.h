@@ -1,0 +1,184 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/reconstruction.h>
+#include <pcl/PointIndices.h>
+#include <pcl/memory.h>
+
+#include <string>
+#include <vector>
+
+namespace pcl {
+
+/** \brief Surface reconstruction that detects undersampling: the boundary-aware
+ * Co-cone of Dey & Giesen, "Detecting undersampling in surface reconstruction"
+ * (SoCG 2001).
+ *
+ * The Voronoi cell of a sample well inside a densely sampled surface is long and
+ * thin along the surface normal ("flat"); at open borders, holes and sharp
+ * features it is not. The class labels every point from the Delaunay
+ * triangulation alone, with no normals and no neighbourhood size:
+ *  - a point is flat when rho * width <= height of its Voronoi cell (ratio
+ *    condition) and its pole line agrees within theta with the pole lines of the
+ *    points that have it as a co-cone neighbour (normal condition);
+ *  - the interior set grows from the flat points to a fixed point; the rest are
+ *    the boundary (undersampled) points.
+ *
+ * \code
+ * pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+ * cocone.setInputCloud (cloud);
+ * pcl::PointIndices boundary;
+ * cocone.detectBoundary (boundary);
+ * \endcode
+ *
+ * Non-finite points are skipped and exact duplicates share one Delaunay vertex;
+ * every index this class returns refers to the input cloud.
+ *
+ * \ingroup surface
+ */
+template <typename PointInT>
+class CoConeBoundary : public SurfaceReconstruction<PointInT> {
+public:
+  using Ptr = shared_ptr<CoConeBoundary<PointInT>>;
+  using ConstPtr = shared_ptr<const CoConeBoundary<PointInT>>;
+
+  using SurfaceReconstruction<PointInT>::reconstruct;
+
+  /** \brief Constructor: the paper's defaults (rho = 1.5, theta = pi / 6, co-cone
+   * angle 3 pi / 8). */
+  CoConeBoundary();
+
+  /** \brief Set the ratio rho of the flatness test rho * width <= height.
+   *
+   * Larger values mark more points as undersampled. The paper uses 1.5 on every data
+   * set and reports that 1.1-1.7 work; theory asks for 1 / (1.3 epsilon) on an
+   * epsilon-sample. A hole whose radius is smaller than about the local feature size
+   * divided by rho is taken as well sampled.
+   * \param[in] ratio rho, finite and > 0 (default 1.5)
+   */
+  void
+  setRatio(double ratio);
+
+  /** \brief Get the ratio rho. */
+  double
+  getRatio() const
+  {
+    return parameters_.ratio;
+  }
+
+  /** \brief Set the normal angle theta of the flatness test.
+   *
+   * A point is flat only if its pole line makes an angle of at most theta with the
+   * pole line of every point that has it as a co-cone neighbour.
+   * \param[in] angle theta in radians, in (0, pi / 2] (default pi / 6; 0.14 in the
+   *            paper's proofs)
+   */
+  void
+  setNormalAngle(double angle);
+
+  /** \brief Get the normal angle theta in radians. */
+  double
+  getNormalAngle() const
+  {
+    return parameters_.normal_angle;
+  }
+
+  /** \brief Set the co-cone angle.
+   *
+   * The co-cone of p is the part of its Voronoi cell seen from p at an angle of at
+   * least this much from the pole line. The paper uses 3 pi / 8 in theory and
+   * practice: smaller angles widen the co-cone and make the ratio test fail more
+   * often, larger ones miss surface triangles.
+   * \param[in] angle in radians, in (0, pi / 2) (default 3 pi / 8)
+   */
+  void
+  setCoconeAngle(double angle);
+
+  /** \brief Get the co-cone angle in radians. */
+  double
+  getCoconeAngle() const
+  {
+    return parameters_.cocone_angle;
+  }
+
+  /** \brief Enable or disable boundary detection.
+   * \param[in] enabled false: every point counts as interior (the original Co-cone,
+   *            which covers holes); default true
+   */
+  void
+  setBoundaryDetection(bool enabled)
+  {
+    parameters_.boundary_detection = enabled;
+  }
+
+  /** \brief Whether boundary detection is enabled. */
+  bool
+  getBoundaryDetection() const
+  {
+    return parameters_.boundary_detection;
+  }
+
+  /** \brief Detect the undersampled points (stages 1-3: Delaunay triangulation,
+   * Voronoi cell geometry, flatness and growth), without building a mesh.
+   * \param[out] boundary indices into the input cloud, ascending; empty on error
+   * \return true on success
+   */
+  bool
+  detectBoundary(pcl::PointIndices& boundary);
+
+  /** \brief The undersampled points found by the last run, indices into the input
+   * cloud, ascending.
+   * \param[out] boundary the indices
+   */
+  void
+  getBoundaryPointIndices(pcl::PointIndices& boundary) const;
+
+  /** \brief Wall-clock time of each stage of the last run, in milliseconds. */
+  const cocone::Timings&
+  getTimings() const
+  {
+    return timings_;
+  }
+
+protected:
+  using SurfaceReconstruction<PointInT>::input_;
+  using SurfaceReconstruction<PointInT>::indices_;
+  using SurfaceReconstruction<PointInT>::initCompute;
+  using SurfaceReconstruction<PointInT>::deinitCompute;
+  using SurfaceReconstruction<PointInT>::check_tree_;
+
+  std::string
+  getClassName() const override
+  {
+    return "CoConeBoundary";
+  }
+
+  /** \brief Not yet available: reconstruction lands with part 2. */
+  void
+  performReconstruction(pcl::PolygonMesh& output) override;
+
+  /** \brief Not yet available: reconstruction lands with part 2. */
+  void
+  performReconstruction(pcl::PointCloud<PointInT>& points,
+                        std::vector<pcl::Vertices>& polygons) override;
+
+private:
+  /** Run the core on the indexed points of the input; false (logged) on error. */
+  bool
+  compute(cocone::Stages stages, const char* caller);
+
+  cocone::Parameters parameters_;
+  cocone::Timings timings_;
+  pcl::Indices boundary_indices_;
+};
+
+} // namespace pcl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <pcl/surface/impl/cocone_boundary.hpp>
+#endif

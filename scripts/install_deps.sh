@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Install the Debian (bookworm) packages the library, its tests and its tool need.
+# Does nothing when they are all present.
+set -euo pipefail
+packages=(cmake g++ make libpcl-dev libcgal-dev libeigen3-dev libflann-dev libtbb-dev
+          libgtest-dev pcl-tools xvfb xauth)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+sudo=""
+[ "$(id -u)" -ne 0 ] && sudo="sudo"
+echo "Installing: ${missing[*]}"
+$sudo apt-get update -q
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"

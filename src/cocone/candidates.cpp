@@ -1,0 +1,54 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/candidates.h>
+
+#include <algorithm>
+
+namespace pcl {
+namespace cocone {
+
+std::vector<Triangle>
+selectCandidates(const VoronoiCells& cells,
+                 const std::vector<std::uint8_t>& boundary,
+                 CandidateRule rule,
+                 const Triangulation* dt)
+{
+  std::vector<Triangle> out;
+  // A triangle none of whose vertices' co-cones meet its dual edge is not in
+  // cells.triangles; it can only be chosen by nobody.
+  for (const auto& t : cells.triangles) {
+    bool chosen = true, any_interior = false;
+    for (int k = 0; k < 3; ++k)
+      if (!boundary[t.v[k]]) {
+        any_interior = true;
+        chosen = chosen && (t.meets & (1u << k));
+      }
+    if (chosen && (any_interior || rule == CandidateRule::LITERAL))
+      out.push_back(t.v);
+  }
+  if (rule == CandidateRule::LITERAL && dt && dt->dimension == 3) {
+    // All-boundary triangles whose dual edge meets no co-cone.
+    for (std::size_t c = 0; c < dt->cells.size(); ++c)
+      for (int i = 0; i < 4; ++i) {
+        const int other = dt->neighbors[c][i];
+        if (other >= 0 && other < static_cast<int>(c))
+          continue;
+        Triangle f;
+        for (int k = 0, j = 0; k < 4; ++k)
+          if (k != i)
+            f[j++] = dt->cells[c][k];
+        std::sort(f.begin(), f.end());
+        if (boundary[f[0]] && boundary[f[1]] && boundary[f[2]])
+          out.push_back(f);
+      }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  return out;
+}
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,114 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/complex.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pcl {
+namespace cocone {
+
+double
+largestAngularGap(std::vector<double>& angles)
+{
+  std::sort(angles.begin(), angles.end());
+  double gap = angles.front() + 2.0 * M_PI - angles.back();
+  for (std::size_t i = 1; i < angles.size(); ++i)
+    gap = std::max(gap, angles[i] - angles[i - 1]);
+  return gap;
+}
+
+TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
+                                 std::vector<Triangle> triangles)
+: points_(points), triangles_(std::move(triangles))
+{
+  for (auto& t : triangles_)
+    std::sort(t.begin(), t.end());
+  std::sort(triangles_.begin(), triangles_.end());
+  const std::size_t m = triangles_.size();
+
+  // Edges: sort (edge key, triangle, slot) once.
+  struct Incidence {
+    std::uint64_t key;
+    int t;
+    int k; // the edge is opposite vertex k of t
+  };
+  std::vector<Incidence> inc;
+  inc.reserve(3 * m);
+  for (std::size_t t = 0; t < m; ++t) {
+    const auto& v = triangles_[t];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t a = v[(k + 1) % 3], b = v[(k + 2) % 3];
+      inc.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), k});
+    }
+  }
+  std::sort(inc.begin(), inc.end(), [](const Incidence& a, const Incidence& b) {
+    return a.key < b.key || (a.key == b.key && a.t < b.t);
+  });
+  triangle_edges_.resize(m);
+  edge_first_.push_back(0);
+  edge_triangles_.reserve(inc.size());
+  edge_angles_.reserve(inc.size());
+  for (std::size_t i = 0; i < inc.size(); ++i) {
+    if (i > 0 && inc[i].key != inc[i - 1].key)
+      edge_first_.push_back(i);
+    if (i == 0 || inc[i].key != inc[i - 1].key)
+      edges_.push_back({static_cast<int>(inc[i].key >> 32),
+                        static_cast<int>(inc[i].key & 0xffffffffu)});
+    const int e = static_cast<int>(edges_.size()) - 1;
+    triangle_edges_[inc[i].t][inc[i].k] = e;
+    edge_triangles_.push_back(inc[i].t);
+  }
+  edge_first_.push_back(inc.size());
+
+  // Angles about each edge in a frame of the edge.
+  edge_angles_.resize(inc.size());
+  for (std::size_t e = 0; e < edges_.size(); ++e) {
+    const Eigen::Vector3d& a = points_[edges_[e][0]];
+    const Eigen::Vector3d d = (points_[edges_[e][1]] - a).normalized();
+    int axis = 0;
+    d.cwiseAbs().minCoeff(&axis);
+    const Eigen::Vector3d x = d.cross(Eigen::Vector3d::Unit(axis)).normalized();
+    const Eigen::Vector3d y = d.cross(x);
+    for (std::size_t i = edge_first_[e]; i < edge_first_[e + 1]; ++i) {
+      const int t = edge_triangles_[i];
+      const auto& v = triangles_[t];
+      const int apex = v[0] + v[1] + v[2] - edges_[e][0] - edges_[e][1];
+      const Eigen::Vector3d w = points_[apex] - a;
+      edge_angles_[i] = std::atan2(w.dot(y), w.dot(x));
+    }
+  }
+
+  // Vertex -> triangles.
+  const int n = static_cast<int>(points_.size());
+  vertex_first_.assign(n + 1, 0);
+  for (const auto& t : triangles_)
+    for (const int v : t)
+      ++vertex_first_[v + 1];
+  for (int v = 0; v < n; ++v)
+    vertex_first_[v + 1] += vertex_first_[v];
+  vertex_triangles_.resize(3 * m);
+  std::vector<std::size_t> fill(vertex_first_.begin(), vertex_first_.end() - 1);
+  for (std::size_t t = 0; t < m; ++t)
+    for (const int v : triangles_[t])
+      vertex_triangles_[fill[v]++] = static_cast<int>(t);
+}
+
+int
+TriangleComplex::edgeOf(int t, int a, int b) const
+{
+  for (const int e : triangle_edges_[t]) {
+    const auto& ed = edges_[e];
+    if ((ed[0] == a && ed[1] == b) || (ed[0] == b && ed[1] == a))
+      return e;
+  }
+  return -1;
+}
+
+} // namespace cocone
+} // namespace pcl

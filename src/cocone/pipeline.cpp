@@ -1,0 +1,186 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/boundary.h>
+#include <pcl/surface/cocone/candidates.h>
+#include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/pruning.h>
+#include <pcl/surface/cocone/repair.h>
+#include <pcl/surface/cocone/triangulation.h>
+#include <pcl/surface/cocone/umbrella.h>
+#include <pcl/surface/cocone/voronoi_cell.h>
+#include <pcl/surface/cocone/walk.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+namespace pcl {
+namespace cocone {
+
+namespace {
+
+class Stopwatch {
+public:
+  /** Milliseconds since the last call (or construction). */
+  double
+  lap()
+  {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/** Stages 4-7 and the repair: the oriented manifold mesh over vertex ids. */
+void
+reconstruct(const Triangulation& dt,
+            const VoronoiCells& cells,
+            const Parameters& parameters,
+            Result& result)
+{
+  auto& counts = result.counts;
+  const std::vector<Triangle> candidates =
+      selectCandidates(cells, result.boundary, parameters.candidate_rule, &dt);
+  counts.candidates = candidates.size();
+  const TriangleComplex complex(dt.points, candidates);
+
+  result.umbrella_failed = umbrellaFailures(complex, result.boundary);
+  std::vector<std::uint8_t> boundary = result.boundary;
+  for (std::size_t v = 0; v < boundary.size(); ++v)
+    if (result.umbrella_failed[v]) {
+      boundary[v] = 1;
+      ++counts.umbrella_failures;
+    }
+
+  const std::vector<std::uint8_t> present = prune(complex, boundary, &counts.pruned);
+  WalkResult walked = walk(complex, present, boundary);
+  counts.walk_components = walked.components;
+  counts.walked = walked.triangles.size();
+  counts.walk_conflicts = walked.conflicts;
+
+  result.triangles = std::move(walked.triangles);
+  repairManifold(dt.points, result.triangles, counts.repair);
+  if (parameters.fill_triangle_holes) {
+    std::vector<Triangle> delaunay;
+    delaunay.reserve(cells.triangles.size());
+    for (const auto& t : cells.triangles)
+      delaunay.push_back(t.v);
+    counts.repair.filled =
+        fillTriangleHoles(result.triangles, dt.points.size(), delaunay);
+    if (counts.repair.filled)
+      repairManifold(dt.points, result.triangles, counts.repair);
+  }
+  // A canonical order: the same input gives the same mesh, whatever the walk order.
+  std::sort(result.triangles.begin(), result.triangles.end(), [](auto a, auto b) {
+    std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
+    std::rotate(b.begin(), std::min_element(b.begin(), b.end()), b.end());
+    return a < b;
+  });
+  for (auto& t : result.triangles)
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+
+  // Normals: the pole line, turned to the side the mesh faces.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Eigen::Vector3d> facing(dt.points.size(), Eigen::Vector3d::Zero());
+  std::vector<std::uint8_t> used(dt.points.size(), 0);
+  for (const auto& t : result.triangles) {
+    const auto& P = dt.points;
+    const Eigen::Vector3d n = (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]);
+    for (const int v : t) {
+      facing[v] += n;
+      used[v] = 1;
+    }
+  }
+  result.normals.assign(dt.points.size(), Eigen::Vector3d::Constant(nan));
+  for (std::size_t v = 0; v < dt.points.size(); ++v)
+    if (used[v]) {
+      const Eigen::Vector3d& pole = cells.pole[v];
+      result.normals[v] = pole.dot(facing[v]) < 0.0 ? Eigen::Vector3d(-pole) : pole;
+    }
+}
+
+} // namespace
+
+Result
+run(const std::vector<Eigen::Vector3d>& points,
+    const Parameters& parameters,
+    Stages stages,
+    const std::vector<int>& ids)
+{
+  Result result;
+  Stopwatch clock;
+  const auto id = [&](std::size_t i) {
+    return ids.empty() ? static_cast<int>(i) : ids[i];
+  };
+  UniquePoints unique = makeUniquePoints(points);
+  result.vertex_of_input = std::move(unique.vertex_of_input);
+  result.vertices = unique.points.size();
+  result.timings.unique = clock.lap();
+  if (unique.points.size() < 4) {
+    result.error = "fewer than 4 distinct finite points (" +
+                   std::to_string(unique.points.size()) + ")";
+    return result;
+  }
+
+  const Triangulation dt = triangulate(unique.points);
+  result.timings.delaunay = clock.lap();
+  if (dt.dimension < 2) {
+    result.error = "the points are collinear";
+    return result;
+  }
+  result.offset = dt.offset;
+
+  const VoronoiCells cells = computeVoronoiCells(dt, parameters.cocone_angle);
+  result.timings.voronoi = clock.lap();
+
+  result.boundary.assign(result.vertices, 0);
+  if (parameters.boundary_detection) {
+    const BoundaryLabels labels =
+        detectBoundary(cells, {parameters.ratio, parameters.normal_angle});
+    for (std::size_t v = 0; v < result.vertices; ++v)
+      result.boundary[v] = !labels.interior[v];
+  }
+  result.timings.boundary = clock.lap();
+
+  result.umbrella_failed.assign(result.vertices, 0);
+  if (stages == Stages::RECONSTRUCTION) {
+    reconstruct(dt, cells, parameters, result);
+    result.timings.reconstruction = clock.lap();
+  }
+
+  // Back to the caller's ids.
+  result.representative.assign(result.vertices, std::numeric_limits<int>::max());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int v = result.vertex_of_input[i];
+    if (v < 0)
+      continue;
+    result.representative[v] = std::min(result.representative[v], id(i));
+    if (result.boundary[v] || result.umbrella_failed[v])
+      result.boundary_indices.push_back(id(i));
+  }
+  std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
+  for (const auto& t : result.triangles)
+    result.polygons.push_back(
+        {result.representative[t[0]], result.representative[t[1]], result.representative[t[2]]});
+  for (auto& loop : boundaryLoops(result.triangles, result.vertices)) {
+    for (auto& v : loop)
+      v = result.representative[v];
+    result.border_loops.push_back(std::move(loop));
+  }
+  result.positions = dt.points;
+  return result;
+}
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,245 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/repair.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+
+namespace pcl {
+namespace cocone {
+
+namespace {
+
+Eigen::Vector3d
+unitNormal(const std::vector<Eigen::Vector3d>& P, const Triangle& t)
+{
+  const Eigen::Vector3d n = (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]);
+  const double len = n.norm();
+  return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+}
+
+/** Remove the triangles marked in drop; returns how many. */
+std::size_t
+compact(std::vector<Triangle>& triangles, const std::vector<std::uint8_t>& drop)
+{
+  std::size_t j = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    if (!drop[t])
+      triangles[j++] = triangles[t];
+  const std::size_t dropped = triangles.size() - j;
+  triangles.resize(j);
+  return dropped;
+}
+
+/** At every edge with more than two triangles keep the best pair. */
+std::size_t
+resolveEdges(const std::vector<Eigen::Vector3d>& P, std::vector<Triangle>& triangles)
+{
+  const EdgeIncidences inc(triangles);
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  bool any = false;
+  for (std::size_t e = 0; e < inc.edges.size(); ++e) {
+    if (inc.count(e) <= 2)
+      continue;
+    const std::size_t f = inc.first[e], l = inc.first[e + 1];
+    std::size_t bi = f, bj = f + 1;
+    double best = -1e300;
+    for (std::size_t i = f; i < l; ++i)
+      for (std::size_t j = i + 1; j < l; ++j) {
+        const double agree = unitNormal(P, triangles[inc.triangle[i]])
+                                 .dot(unitNormal(P, triangles[inc.triangle[j]]));
+        // A pair that traverses the edge the same way cannot be kept as it is.
+        const double s = agree - (inc.forward[i] == inc.forward[j] ? 10.0 : 0.0);
+        if (s > best) {
+          best = s;
+          bi = i;
+          bj = j;
+        }
+      }
+    for (std::size_t i = f; i < l; ++i)
+      if (i != bi && i != bj) {
+        drop[inc.triangle[i]] = 1;
+        any = true;
+      }
+  }
+  return any ? compact(triangles, drop) : 0;
+}
+
+/** At every vertex with several fans keep the largest. */
+std::size_t
+resolveVertices(std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  std::vector<int> fans;
+  const std::vector<int> fan = vertexFans(triangles, num_vertices, &fans);
+  std::vector<int> size_first(num_vertices + 1, 0);
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    size_first[v + 1] = size_first[v] + fans[v];
+  std::vector<int> size(size_first.back(), 0);
+  for (std::size_t c = 0; c < fan.size(); ++c)
+    ++size[size_first[triangles[c / 3][c % 3]] + fan[c]];
+  std::vector<int> keep(num_vertices, 0);
+  bool any = false;
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    if (fans[v] > 1) {
+      any = true;
+      const auto b = size.begin() + size_first[v];
+      keep[v] = static_cast<int>(std::max_element(b, b + fans[v]) - b);
+    }
+  if (!any)
+    return 0;
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  for (std::size_t c = 0; c < fan.size(); ++c) {
+    const int v = triangles[c / 3][c % 3];
+    if (fans[v] > 1 && fan[c] != keep[v])
+      drop[c / 3] = 1;
+  }
+  return compact(triangles, drop);
+}
+
+/** Orient each component consistently and outward; returns triangles that could not
+ * be oriented (dropped). */
+std::size_t
+orient(const std::vector<Eigen::Vector3d>& P,
+       std::vector<Triangle>& triangles,
+       std::size_t& flipped)
+{
+  const EdgeIncidences inc(triangles);
+  const std::size_t m = triangles.size();
+  // Per triangle: its edges' ids, found through the incidences.
+  std::vector<std::array<int, 3>> tri_edges(m);
+  std::vector<int> filled(m, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i)
+      tri_edges[inc.triangle[i]][filled[inc.triangle[i]]++] = static_cast<int>(e);
+  const auto traverses_forward = [&](int t, int e) {
+    const auto& v = triangles[t];
+    const int a = inc.edges[e][0], b = inc.edges[e][1];
+    for (int k = 0; k < 3; ++k)
+      if (v[k] == a && v[(k + 1) % 3] == b)
+        return true;
+    return false;
+  };
+
+  std::vector<int> component(m, -1);
+  std::vector<std::uint8_t> drop(m, 0);
+  std::vector<int> queue, members;
+  int c = 0;
+  for (std::size_t s = 0; s < m; ++s, members.clear()) {
+    if (component[s] >= 0)
+      continue;
+    component[s] = c;
+    queue.assign(1, static_cast<int>(s));
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+      const int t = queue[qi];
+      members.push_back(t);
+      for (const int e : tri_edges[t]) {
+        if (inc.count(e) != 2)
+          continue;
+        const std::size_t i = inc.first[e];
+        const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
+        const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
+        if (component[t2] < 0) {
+          component[t2] = c;
+          if (same) {
+            std::swap(triangles[t2][1], triangles[t2][2]);
+            ++flipped;
+          }
+          queue.push_back(t2);
+        }
+        else if (same && !drop[t] && !drop[t2])
+          drop[std::max(t, t2)] = 1; // a non-orientable cycle closes here
+      }
+    }
+    // Turn the component so that its signed volume about its centroid is positive.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const int t : members)
+      centre += P[triangles[t][0]] + P[triangles[t][1]] + P[triangles[t][2]];
+    centre /= 3.0 * static_cast<double>(members.size());
+    double volume = 0.0;
+    for (const int t : members) {
+      const auto& v = triangles[t];
+      volume += (P[v[0]] - centre).dot((P[v[1]] - centre).cross(P[v[2]] - centre));
+    }
+    if (volume < 0.0)
+      for (const int t : members)
+        std::swap(triangles[t][1], triangles[t][2]);
+    ++c;
+  }
+  return compact(triangles, drop);
+}
+
+} // namespace
+
+void
+repairManifold(const std::vector<Eigen::Vector3d>& points,
+               std::vector<Triangle>& triangles,
+               RepairCounts& counts)
+{
+  for (;;) {
+    if (const std::size_t d = resolveEdges(points, triangles)) {
+      counts.nonmanifold_edge += d;
+      continue;
+    }
+    if (const std::size_t d = resolveVertices(triangles, points.size())) {
+      counts.nonmanifold_vertex += d;
+      continue;
+    }
+    const std::size_t d = orient(points, triangles, counts.flipped);
+    if (d == 0)
+      return;
+    counts.orientation += d;
+  }
+}
+
+std::size_t
+fillTriangleHoles(std::vector<Triangle>& triangles,
+                  std::size_t num_vertices,
+                  const std::vector<Triangle>& allowed)
+{
+  const EdgeIncidences inc(triangles);
+  // Hole half-edges run against the border half-edges of the triangles.
+  std::vector<int> hole_next(num_vertices, -1);
+  std::vector<int> starts;
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1) {
+      const bool fwd = inc.forward[inc.first[e]];
+      const int a = fwd ? inc.edges[e][0] : inc.edges[e][1];
+      const int b = fwd ? inc.edges[e][1] : inc.edges[e][0];
+      hole_next[b] = a;
+      starts.push_back(b);
+    }
+  std::vector<Triangle> present;
+  present.reserve(triangles.size());
+  for (auto t : triangles) {
+    std::sort(t.begin(), t.end());
+    present.push_back(t);
+  }
+  std::sort(present.begin(), present.end());
+  std::sort(starts.begin(), starts.end());
+  std::size_t added = 0;
+  for (const int x : starts) {
+    const int y = hole_next[x];
+    if (y < 0)
+      continue;
+    const int z = hole_next[y];
+    if (z < 0 || z == x || hole_next[z] != x)
+      continue;
+    Triangle key{x, y, z};
+    std::sort(key.begin(), key.end());
+    if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
+        std::binary_search(present.begin(), present.end(), key))
+      continue;
+    triangles.push_back({x, y, z});
+    hole_next[x] = hole_next[y] = hole_next[z] = -1;
+    ++added;
+  }
+  return added;
+}
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,77 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/umbrella.h>
+
+#include <algorithm>
+
+namespace pcl {
+namespace cocone {
+
+bool
+hasUmbrella(const TriangleComplex& complex, int p)
+{
+  const std::size_t first = complex.vertexBegin(p), last = complex.vertexEnd(p);
+  if (first == last)
+    return false;
+  // Every triangle at an edge pq contains p: the star is all the cascade can touch.
+  // (The incidence list of a vertex is in ascending triangle order.)
+  thread_local std::vector<int> star;
+  thread_local std::vector<char> removed;
+  thread_local std::vector<int> pending;
+  star.clear();
+  for (std::size_t i = first; i < last; ++i)
+    star.push_back(complex.vertexTriangle(i));
+  removed.assign(star.size(), 0);
+  const auto alive = [&](int t) {
+    const auto it = std::lower_bound(star.begin(), star.end(), t);
+    return it != star.end() && *it == t && !removed[it - star.begin()];
+  };
+  std::size_t remaining = star.size();
+
+  pending.clear();
+  for (const int t : star)
+    for (int k = 0; k < 3; ++k)
+      if (complex.triangle(t)[k] != p) // the edges at p are those opposite the others
+        pending.push_back(complex.triangleEdges(t)[k]);
+  std::sort(pending.begin(), pending.end());
+  pending.erase(std::unique(pending.begin(), pending.end()), pending.end());
+  std::reverse(pending.begin(), pending.end());
+
+  while (!pending.empty()) {
+    const int e = pending.back();
+    pending.pop_back();
+    if (!complex.isSharp(e, alive))
+      continue;
+    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+      const int t = complex.edgeTriangle(i);
+      if (!alive(t))
+        continue;
+      removed[std::lower_bound(star.begin(), star.end(), t) - star.begin()] = 1;
+      if (--remaining == 0)
+        return false;
+      for (int k = 0; k < 3; ++k) {
+        const int e2 = complex.triangleEdges(t)[k];
+        if (complex.triangle(t)[k] != p && e2 != e)
+          pending.push_back(e2);
+      }
+    }
+  }
+  return true;
+}
+
+std::vector<std::uint8_t>
+umbrellaFailures(const TriangleComplex& complex,
+                 const std::vector<std::uint8_t>& boundary)
+{
+  std::vector<std::uint8_t> failed(boundary.size(), 0);
+  for (std::size_t p = 0; p < boundary.size(); ++p)
+    if (!boundary[p])
+      failed[p] = !hasUmbrella(complex, static_cast<int>(p));
+  return failed;
+}
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,157 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/walk.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <utility>
+
+namespace pcl {
+namespace cocone {
+
+int
+surfaceNeighbor(const TriangleComplex& complex,
+                const std::vector<std::uint8_t>& present,
+                int t,
+                int x,
+                int y,
+                int z,
+                int& apex)
+{
+  const auto& P = complex.points();
+  const int e = complex.edgeOf(t, x, y);
+  // Frame of the edge: u in t's plane towards z, n along t's normal.
+  const Eigen::Vector3d d = (P[y] - P[x]).normalized();
+  Eigen::Vector3d u = P[z] - P[x];
+  u = (u - u.dot(d) * d).normalized();
+  const Eigen::Vector3d n = d.cross(u);
+  int best = -1;
+  double best_phi = 0.0;
+  for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+    const int t2 = complex.edgeTriangle(i);
+    if (t2 == t || !present[t2])
+      continue;
+    const auto& v = complex.triangle(t2);
+    const int a = v[0] + v[1] + v[2] - x - y;
+    const Eigen::Vector3d w = P[a] - P[x];
+    // (y, x, a)'s normal makes an angle below pi/2 with t's exactly when a lies
+    // beyond the edge, on the side away from z.
+    const double cx = w.dot(u);
+    if (cx >= 0.0)
+      continue;
+    double phi = std::atan2(w.dot(n), cx);
+    if (phi < 0.0)
+      phi += 2.0 * M_PI;
+    if (best < 0 || phi < best_phi) {
+      best = t2;
+      best_phi = phi;
+      apex = a;
+    }
+  }
+  return best;
+}
+
+WalkResult
+walk(const TriangleComplex& complex,
+     const std::vector<std::uint8_t>& present,
+     const std::vector<std::uint8_t>& boundary)
+{
+  const int m = static_cast<int>(complex.numTriangles());
+  WalkResult out;
+
+  // Connected components of the present triangles (through shared edges).
+  std::vector<int> component(m, -1), stack;
+  std::vector<int> seeds;
+  std::vector<int> edge_count(complex.numEdges(), 0);
+  for (int t = 0; t < m; ++t)
+    if (present[t])
+      for (const int e : complex.triangleEdges(t))
+        ++edge_count[e];
+  const auto score = [&](int t) {
+    const auto& v = complex.triangle(t);
+    const bool umbrellas = !boundary[v[0]] && !boundary[v[1]] && !boundary[v[2]];
+    bool manifold = true;
+    for (const int e : complex.triangleEdges(t))
+      manifold = manifold && edge_count[e] == 2;
+    return 2 * umbrellas + manifold;
+  };
+  for (int s = 0; s < m; ++s) {
+    if (!present[s] || component[s] >= 0)
+      continue;
+    const int c = static_cast<int>(seeds.size());
+    int seed = s, seed_score = score(s);
+    component[s] = c;
+    stack.assign(1, s);
+    while (!stack.empty()) {
+      const int t = stack.back();
+      stack.pop_back();
+      const int sc = score(t);
+      if (sc > seed_score || (sc == seed_score && t < seed)) {
+        seed = t;
+        seed_score = sc;
+      }
+      for (const int e : complex.triangleEdges(t))
+        for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+          const int t2 = complex.edgeTriangle(i);
+          if (present[t2] && component[t2] < 0) {
+            component[t2] = c;
+            stack.push_back(t2);
+          }
+        }
+    }
+    seeds.push_back(seed);
+  }
+  out.components = seeds.size();
+
+  // The walk, as in the paper: every edge is processed once.
+  std::vector<std::uint8_t> processed(complex.numEdges(), 0);
+  std::vector<Triangle> oriented(m);
+  std::vector<std::uint8_t> in_surface(m, 0);
+  struct Pending {
+    int x, y, t;
+  };
+  std::vector<Pending> pending;
+  for (const int s : seeds) {
+    const auto& v = complex.triangle(s);
+    oriented[s] = v;
+    in_surface[s] = 1;
+    out.triangles.push_back(v);
+    pending = {{v[2], v[0], s}, {v[1], v[2], s}, {v[0], v[1], s}};
+    while (!pending.empty()) {
+      const Pending p = pending.back();
+      pending.pop_back();
+      const int e = complex.edgeOf(p.t, p.x, p.y);
+      if (processed[e])
+        continue;
+      processed[e] = 1;
+      const auto& o = oriented[p.t];
+      const int z = o[0] + o[1] + o[2] - p.x - p.y;
+      int a = -1;
+      const int t2 = surfaceNeighbor(complex, present, p.t, p.x, p.y, z, a);
+      if (t2 < 0)
+        continue;
+      const Triangle next{p.y, p.x, a};
+      if (in_surface[t2]) {
+        // Reached again: keep the first orientation, count a disagreement.
+        const auto& q = oriented[t2];
+        for (int k = 0; k < 3; ++k)
+          if (q[k] == p.x && q[(k + 1) % 3] == p.y)
+            ++out.conflicts;
+        continue;
+      }
+      oriented[t2] = next;
+      in_surface[t2] = 1;
+      out.triangles.push_back(next);
+      pending.push_back({a, p.y, t2});
+      pending.push_back({p.x, a, t2});
+    }
+  }
+  return out;
+}
+
+} // namespace cocone
+} // namespace pcl

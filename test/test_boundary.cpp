@@ -1,0 +1,101 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/boundary.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace pcl::cocone;
+
+namespace {
+
+Eigen::Vector3d
+tilted(double degrees)
+{
+  const double a = degrees * M_PI / 180.0;
+  return {std::sin(a), 0.0, std::cos(a)};
+}
+
+/** Four hand-made Voronoi cells: see the comments of each test. */
+VoronoiCells
+handMade()
+{
+  VoronoiCells vc;
+  // v0: w 1, h 2, pole 0 deg  -> passes the ratio test at rho 1.5
+  // v1: w 1, h 1, pole 0 deg  -> fails it
+  // v2: w 1, h 2, pole 45 deg -> passes the ratio test
+  // v3: w 1, h 2, pole 20 deg -> passes the ratio test
+  vc.pole = {tilted(0), tilted(0), tilted(45), tilted(20)};
+  vc.height_plus = {2, 1, 2, 2};
+  vc.height_minus = {3, 3, 3, 3};
+  vc.width = {1, 1, 1, 1};
+  vc.on_hull = {0, 0, 0, 0};
+  return vc;
+}
+
+} // namespace
+
+TEST(DetectBoundary, RatioCondition)
+{
+  VoronoiCells vc = handMade();
+  const BoundaryLabels l = detectBoundary(vc, {1.5, M_PI / 6});
+  EXPECT_EQ(l.ratio_ok, (std::vector<std::uint8_t>{1, 0, 1, 1}));
+  // No co-cone triangles: nothing constrains the normals.
+  EXPECT_EQ(l.flat, (std::vector<std::uint8_t>{1, 0, 1, 1}));
+  // rho 2.5 asks for h >= 2.5 w: nobody is flat.
+  EXPECT_EQ(detectBoundary(vc, {2.5, M_PI / 6}).interior,
+            (std::vector<std::uint8_t>{0, 0, 0, 0}));
+  // Unbounded width never passes, even with an infinite height.
+  vc.width[0] = std::numeric_limits<double>::infinity();
+  vc.height_plus[0] = vc.height_minus[0] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(detectBoundary(vc, {1.5, M_PI / 6}).ratio_ok[0]);
+}
+
+TEST(DetectBoundary, NormalConditionAndGrowth)
+{
+  VoronoiCells vc = handMade();
+  // The co-cone of v0 meets the dual edge of triangle (0, 2, 3): N_0 = {2, 3}.
+  // v2's pole is 45 deg from v0's (> theta = 30 deg): v2 is not flat. v3 is 20 deg
+  // off: flat.
+  vc.triangles.push_back({{0, 2, 3}, 0b001});
+  BoundaryLabels l = detectBoundary(vc, {1.5, M_PI / 6});
+  EXPECT_EQ(l.flat, (std::vector<std::uint8_t>{1, 0, 0, 1}));
+  EXPECT_EQ(l.interior, (std::vector<std::uint8_t>{1, 0, 0, 1}));
+
+  // The co-cone of v3 meets the dual edge of (1, 2, 3): N_3 = {1, 2}. v2 is 25 deg
+  // from v3 and passes the ratio test, so it joins R through v3; v1 fails the ratio
+  // test and stays a boundary vertex.
+  vc.triangles.push_back({{1, 2, 3}, 0b100});
+  l = detectBoundary(vc, {1.5, M_PI / 6});
+  EXPECT_EQ(l.flat, (std::vector<std::uint8_t>{1, 0, 0, 1}));
+  EXPECT_EQ(l.interior, (std::vector<std::uint8_t>{1, 0, 1, 1}));
+
+  // With theta = 20 deg the 25 deg step is too large: no growth.
+  l = detectBoundary(vc, {1.5, 20.0 * M_PI / 180.0});
+  EXPECT_EQ(l.interior, (std::vector<std::uint8_t>{1, 0, 0, 1}));
+}
+
+TEST(DetectBoundary, NormalConditionReadsTheDirection)
+{
+  // The same triangle, but now the co-cone of v2 meets its dual edge: N_2 = {0, 3},
+  // so v0 and v3 are judged against v2 (45 and 25 deg): only v0 fails.
+  VoronoiCells vc = handMade();
+  vc.triangles.push_back({{0, 2, 3}, 0b010});
+  const BoundaryLabels l = detectBoundary(vc, {1.5, M_PI / 6});
+  EXPECT_EQ(l.flat, (std::vector<std::uint8_t>{0, 0, 1, 1}));
+  // v0 passes the ratio test but cannot grow from v2 (45 deg): stays boundary.
+  EXPECT_EQ(l.interior, (std::vector<std::uint8_t>{0, 0, 1, 1}));
+}
+
+TEST(DetectBoundary, PoleLinesNotVectors)
+{
+  // Opposite pole vectors are the same line: angle 0.
+  VoronoiCells vc = handMade();
+  vc.pole[3] = -tilted(0);
+  vc.triangles.push_back({{0, 2, 3}, 0b001});
+  EXPECT_TRUE(detectBoundary(vc, {1.5, M_PI / 6}).flat[3]);
+}

@@ -1,0 +1,261 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone_boundary.h>
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <support/metrics.h>
+#include <support/surfaces.h>
+
+#include <cmath>
+#include <limits>
+
+namespace {
+
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr
+toCloud(const std::vector<Eigen::Vector3d>& points)
+{
+  typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+  for (const auto& p : points) {
+    PointT q;
+    q.x = static_cast<float>(p.x());
+    q.y = static_cast<float>(p.y());
+    q.z = static_cast<float>(p.z());
+    cloud->push_back(q);
+  }
+  return cloud;
+}
+
+cocone_test::Sample
+hemisphere(std::size_t n = 3000)
+{
+  cocone_test::SampleOptions o;
+  o.n = n;
+  return cocone_test::hemisphere(o);
+}
+
+std::vector<int>
+detect(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud, bool* ok = nullptr)
+{
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  pcl::PointIndices boundary;
+  const bool success = cocone.detectBoundary(boundary);
+  if (ok)
+    *ok = success;
+  return {boundary.indices.begin(), boundary.indices.end()};
+}
+
+} // namespace
+
+TEST(CoConeBoundary, DefaultsAndSetterValidation)
+{
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  EXPECT_DOUBLE_EQ(cocone.getRatio(), 1.5);
+  EXPECT_DOUBLE_EQ(cocone.getNormalAngle(), M_PI / 6.0);
+  EXPECT_DOUBLE_EQ(cocone.getCoconeAngle(), 3.0 * M_PI / 8.0);
+  EXPECT_TRUE(cocone.getBoundaryDetection());
+  cocone.setRatio(2.5);
+  EXPECT_DOUBLE_EQ(cocone.getRatio(), 2.5);
+  cocone.setRatio(-1.0);
+  cocone.setRatio(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_DOUBLE_EQ(cocone.getRatio(), 2.5);
+  cocone.setNormalAngle(0.0);
+  cocone.setNormalAngle(2.0);
+  EXPECT_DOUBLE_EQ(cocone.getNormalAngle(), M_PI / 6.0);
+  cocone.setCoconeAngle(M_PI / 2.0);
+  EXPECT_DOUBLE_EQ(cocone.getCoconeAngle(), 3.0 * M_PI / 8.0);
+  cocone.setCoconeAngle(1.0);
+  EXPECT_DOUBLE_EQ(cocone.getCoconeAngle(), 1.0);
+}
+
+TEST(CoConeBoundary, NoInputIsAnError)
+{
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  pcl::PointIndices boundary;
+  boundary.indices = {1, 2, 3};
+  EXPECT_FALSE(cocone.detectBoundary(boundary));
+  EXPECT_TRUE(boundary.indices.empty());
+}
+
+TEST(CoConeBoundary, TooFewPointsAreAnError)
+{
+  for (std::size_t n = 0; n < 4; ++n) {
+    std::vector<Eigen::Vector3d> pts;
+    for (std::size_t i = 0; i < n; ++i)
+      pts.emplace_back(double(i), double(i * i), 1.0 - double(i));
+    bool ok = true;
+    EXPECT_TRUE(detect(toCloud<pcl::PointXYZ>(pts), &ok).empty());
+    EXPECT_FALSE(ok) << n << " points";
+  }
+  // Many copies of three points are still three points.
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < 30; ++i)
+    pts.emplace_back(double(i % 3), double(i % 3 == 1), 0.0);
+  bool ok = true;
+  EXPECT_TRUE(detect(toCloud<pcl::PointXYZ>(pts), &ok).empty());
+  EXPECT_FALSE(ok);
+  // ... and all-identical points are one.
+  ok = true;
+  EXPECT_TRUE(
+      detect(toCloud<pcl::PointXYZ>(std::vector<Eigen::Vector3d>(50, {1, 2, 3})), &ok)
+          .empty());
+  EXPECT_FALSE(ok);
+}
+
+TEST(CoConeBoundary, CollinearInputIsAnError)
+{
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < 100; ++i)
+    pts.emplace_back(0.5 * i, 1.0 + i, -2.0 * i);
+  bool ok = true;
+  EXPECT_TRUE(detect(toCloud<pcl::PointXYZ>(pts), &ok).empty());
+  EXPECT_FALSE(ok);
+}
+
+TEST(CoConeBoundary, NonFinitePointsAreSkipped)
+{
+  const auto s = hemisphere();
+  const auto clean = detect(toCloud<pcl::PointXYZ>(s.points));
+  ASSERT_FALSE(clean.empty());
+
+  // Insert a NaN or Inf point before every 7th point; map the clean result over.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  auto cloud = toCloud<pcl::PointXYZ>({});
+  std::vector<int> new_index;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    if (i % 7 == 0)
+      cloud->push_back(i % 2 ? pcl::PointXYZ(nan, 0, 0) : pcl::PointXYZ(0, inf, 0));
+    new_index.push_back(static_cast<int>(cloud->size()));
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(s.points[i].x()),
+                                   static_cast<float>(s.points[i].y()),
+                                   static_cast<float>(s.points[i].z())));
+  }
+  cloud->is_dense = false;
+  std::vector<int> expected;
+  for (const int i : clean)
+    expected.push_back(new_index[i]);
+  EXPECT_EQ(detect(cloud), expected);
+}
+
+TEST(CoConeBoundary, DuplicatesShareTheirLabel)
+{
+  const auto s = hemisphere();
+  auto cloud = toCloud<pcl::PointXYZ>(s.points);
+  const std::size_t n = cloud->size();
+  // Append a copy of every point: each copy must get its original's label.
+  for (std::size_t i = 0; i < n; ++i)
+    cloud->push_back((*cloud)[i]);
+  const auto clean = detect(toCloud<pcl::PointXYZ>(s.points));
+  std::vector<int> expected;
+  for (const int i : clean)
+    expected.push_back(i);
+  for (const int i : clean)
+    expected.push_back(i + static_cast<int>(n));
+  EXPECT_EQ(detect(cloud), expected);
+}
+
+TEST(CoConeBoundary, IndicesSelectASubsetAndRefertoTheCloud)
+{
+  const auto s = hemisphere();
+  const auto clean = detect(toCloud<pcl::PointXYZ>(s.points));
+  // Put the hemisphere's points at odd positions, junk at even ones.
+  auto cloud = toCloud<pcl::PointXYZ>({});
+  pcl::IndicesPtr indices(new pcl::Indices);
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    cloud->push_back(pcl::PointXYZ(100.0f + float(i % 13), float(i % 5), float(i % 3)));
+    indices->push_back(static_cast<int>(cloud->size()));
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(s.points[i].x()),
+                                   static_cast<float>(s.points[i].y()),
+                                   static_cast<float>(s.points[i].z())));
+  }
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  cocone.setIndices(indices);
+  pcl::PointIndices boundary;
+  ASSERT_TRUE(cocone.detectBoundary(boundary));
+  std::vector<int> expected;
+  for (const int i : clean)
+    expected.push_back(2 * i + 1);
+  EXPECT_EQ(std::vector<int>(boundary.indices.begin(), boundary.indices.end()),
+            expected);
+  pcl::PointIndices again;
+  cocone.getBoundaryPointIndices(again);
+  EXPECT_EQ(again.indices, boundary.indices);
+
+  // An index outside the cloud is an error, not a crash.
+  indices->push_back(static_cast<int>(cloud->size()) + 10);
+  cocone.setIndices(indices);
+  EXPECT_FALSE(cocone.detectBoundary(boundary));
+  EXPECT_TRUE(boundary.indices.empty());
+}
+
+TEST(CoConeBoundary, FlatWallHasItsOutlineAsBoundary)
+{
+  // A jittered planar grid (a wall scan): outline points are boundary, inner points
+  // interior.
+  std::vector<Eigen::Vector3d> pts;
+  const int nx = 60, ny = 40;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const double jx = 0.2 * std::sin(i * 12.9898 + j * 78.233);
+      const double jy = 0.2 * std::cos(i * 39.3468 + j * 11.135);
+      const bool edge = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+      // Keep the outline straight so that it is the convex hull.
+      pts.emplace_back(edge ? i : i + jx, edge ? j : j + jy, 0.0);
+    }
+  // Tilt the wall so that it is no coordinate plane.
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (auto& p : pts)
+    p = R * p;
+  const auto boundary = detect(toCloud<pcl::PointXYZ>(pts));
+  std::vector<bool> is_boundary(pts.size(), false);
+  for (const int i : boundary)
+    is_boundary[i] = true;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const bool edge = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+      EXPECT_EQ(is_boundary[i * ny + j], edge) << i << ", " << j;
+    }
+}
+
+template <typename PointT>
+class CoConeBoundaryTyped : public ::testing::Test {};
+using XYZTypes = ::testing::Types<pcl::PointXYZ,
+                                  pcl::PointXYZI,
+                                  pcl::PointXYZL,
+                                  pcl::PointXYZRGBA,
+                                  pcl::PointXYZRGB,
+                                  pcl::PointXYZRGBL,
+                                  pcl::PointXYZLAB,
+                                  pcl::PointXYZHSV,
+                                  pcl::InterestPoint,
+                                  pcl::PointNormal,
+                                  pcl::PointXYZRGBNormal,
+                                  pcl::PointXYZINormal,
+                                  pcl::PointXYZLNormal,
+                                  pcl::PointWithRange,
+                                  pcl::PointWithViewpoint,
+                                  pcl::PointWithScale,
+                                  pcl::PointSurfel,
+                                  pcl::PointDEM>;
+TYPED_TEST_SUITE(CoConeBoundaryTyped, XYZTypes);
+
+TYPED_TEST(CoConeBoundaryTyped, EveryInstantiatedTypeRuns)
+{
+  const auto s = hemisphere(1500);
+  pcl::CoConeBoundary<TypeParam> cocone;
+  cocone.setInputCloud(toCloud<TypeParam>(s.points));
+  pcl::PointIndices boundary;
+  ASSERT_TRUE(cocone.detectBoundary(boundary));
+  const auto score = cocone_test::scoreBoundary(
+      s, std::vector<int>(boundary.indices.begin(), boundary.indices.end()));
+  EXPECT_GE(score.precision, 0.9) << score.str();
+}

@@ -1,0 +1,103 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/triangulation.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace pcl::cocone;
+
+TEST(UniquePoints, SkipsNonFiniteAndMergesDuplicates)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<Eigen::Vector3d> in{
+      {1, 2, 3}, {nan, 0, 0}, {0, 0, 0}, {1, 2, 3}, {0, inf, 0}, {1, 2, 3 + 1e-9}};
+  const UniquePoints u = makeUniquePoints(in);
+  ASSERT_EQ(u.points.size(), 3u);
+  EXPECT_EQ(u.vertex_of_input[1], -1);
+  EXPECT_EQ(u.vertex_of_input[4], -1);
+  EXPECT_EQ(u.vertex_of_input[0], u.vertex_of_input[3]);
+  EXPECT_NE(u.vertex_of_input[0], u.vertex_of_input[5]); // near-duplicate is distinct
+  for (std::size_t i = 0; i < in.size(); ++i)
+    if (u.vertex_of_input[i] >= 0)
+      EXPECT_EQ(u.points[u.vertex_of_input[i]], in[i]);
+}
+
+TEST(UniquePoints, VertexIdsDoNotDependOnInputOrder)
+{
+  const std::vector<Eigen::Vector3d> a{{3, 0, 0}, {1, 1, 1}, {0, 5, 0}, {2, 2, 2}};
+  const std::vector<Eigen::Vector3d> b{a[2], a[0], a[3], a[1]};
+  EXPECT_EQ(makeUniquePoints(a).points, makeUniquePoints(b).points);
+}
+
+TEST(Triangulate, DimensionOfDegenerateInput)
+{
+  EXPECT_EQ(triangulate({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}).dimension, 1);
+  const Triangulation flat = triangulate({{0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
+  EXPECT_EQ(flat.dimension, 2);
+  EXPECT_EQ(flat.cells.size(), 2u);
+  for (const auto& c : flat.cells)
+    EXPECT_EQ(c[3], -1);
+}
+
+TEST(Triangulate, CellsNeighboursAndCircumcenters)
+{
+  std::vector<Eigen::Vector3d> P;
+  for (int i = 0; i < 200; ++i) // a deterministic scatter
+    P.emplace_back(std::sin(i * 1.7), std::cos(i * 2.3), std::sin(i * 0.9 + 1.0));
+  const Triangulation dt = triangulate(makeUniquePoints(P).points);
+  ASSERT_EQ(dt.dimension, 3);
+  ASSERT_EQ(dt.cells.size(), dt.circumcenters.size());
+  std::size_t hull_facets = 0;
+  for (std::size_t c = 0; c < dt.cells.size(); ++c) {
+    // The circumcenter is equidistant from the four vertices.
+    const double r = (dt.circumcenters[c] - dt.points[dt.cells[c][0]]).norm();
+    for (int i = 1; i < 4; ++i)
+      EXPECT_NEAR((dt.circumcenters[c] - dt.points[dt.cells[c][i]]).norm(), r, 1e-9 * r);
+    for (int i = 0; i < 4; ++i) {
+      const int nb = dt.neighbors[c][i];
+      if (nb < 0) {
+        ++hull_facets;
+        continue;
+      }
+      // Adjacency is symmetric.
+      int back = 0;
+      for (int j = 0; j < 4; ++j)
+        back += dt.neighbors[nb][j] == static_cast<int>(c);
+      EXPECT_EQ(back, 1);
+    }
+  }
+  EXPECT_GT(hull_facets, 0u);
+}
+
+TEST(Triangulate, RecentresLargeCoordinates)
+{
+  std::vector<Eigen::Vector3d> P{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (auto& p : P)
+    p += Eigen::Vector3d(5e6, 5e6, 1e3);
+  const Triangulation dt = triangulate(P);
+  ASSERT_EQ(dt.dimension, 3);
+  EXPECT_LT(dt.points[0].norm(), 1.0);
+  EXPECT_EQ(dt.points[0] + dt.offset, P[0]);
+}
+
+TEST(Circumcenter, NearlyFlatTetrahedronStaysFinite)
+{
+  // A sliver: the circumcenter is far away but still equidistant.
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), d(0.7, 0.2, 1e-9);
+  const Eigen::Vector3d cc = tetrahedronCircumcenter(a, b, c, d);
+  ASSERT_TRUE(std::isfinite(cc.z()));
+  EXPECT_GT(std::abs(cc.z()), 1e6);
+  const double r = (cc - a).norm();
+  for (const auto& x : {b, c, d})
+    EXPECT_NEAR((cc - x).norm(), r, 1e-9 * r);
+  const Eigen::Vector3d t = triangleCircumcenter(a, b, c);
+  EXPECT_NEAR(t.x(), 0.5, 1e-15);
+  EXPECT_NEAR(t.y(), 0.5, 1e-15);
+}
