@@ -24,9 +24,11 @@ TEST(UniquePoints, SkipsNonFiniteAndMergesDuplicates)
   EXPECT_EQ(u.vertex_of_input[4], -1);
   EXPECT_EQ(u.vertex_of_input[0], u.vertex_of_input[3]);
   EXPECT_NE(u.vertex_of_input[0], u.vertex_of_input[5]); // near-duplicate is distinct
-  for (std::size_t i = 0; i < in.size(); ++i)
-    if (u.vertex_of_input[i] >= 0)
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (u.vertex_of_input[i] >= 0) {
       EXPECT_EQ(u.points[u.vertex_of_input[i]], in[i]);
+    }
+  }
 }
 
 TEST(UniquePoints, VertexIdsDoNotDependOnInputOrder)

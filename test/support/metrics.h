@@ -5,6 +5,9 @@
 
 #pragma once
 
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/pipeline.h>
+
 #include <support/surfaces.h>
 
 #include <Eigen/Core>
@@ -25,6 +28,10 @@ public:
   double
   nearest(const Eigen::Vector3d& q, double radius) const;
 
+  /** Indices of the points within \a radius of \a q. */
+  std::vector<int>
+  within(const Eigen::Vector3d& q, double radius) const;
+
 private:
   std::int64_t
   key(long x, long y, long z) const;
@@ -34,7 +41,11 @@ private:
   std::unordered_map<std::int64_t, std::vector<int>> grid_;
 };
 
-/** \brief Quality of a reported boundary against the true boundary curve. */
+/** \brief Quality of a reported boundary against the true boundary curve.
+ *
+ * Distances are in local sample spacings (the mean nearest-neighbour distance of the
+ * samples within four global spacings), so that unevenly sampled surfaces are judged
+ * by their own density. */
 struct BoundaryScore {
   /** Share of the true boundary curve with a reported point within 2.5 spacings. */
   double recall = 0.0;
@@ -51,5 +62,25 @@ struct BoundaryScore {
 /** \brief Score reported boundary indices (into s.points) against s. */
 BoundaryScore
 scoreBoundary(const Sample& s, const std::vector<int>& reported);
+
+/** \brief Quality of a reconstructed mesh against its sample's ground truth. */
+struct MeshScore {
+  pcl::cocone::MeshTopology topology;
+  std::size_t loops = 0;
+  /** Share of the sample's points used by a triangle. */
+  double used_share = 0.0;
+  /** Largest distance of a triangle's centroid or edge midpoint from the true
+   * surface, in sample spacings. */
+  double max_distance = 0.0;
+  /** Signed volume of the mesh (positive: facing outward). */
+  double volume = 0.0;
+
+  std::string
+  str() const;
+};
+
+/** \brief Score the mesh of a pipeline result computed on s.points. */
+MeshScore
+scoreMesh(const Sample& s, const pcl::cocone::Result& r);
 
 } // namespace cocone_test

@@ -8,6 +8,7 @@
 #include <pcl/surface/cocone/pipeline.h>
 #include <pcl/surface/reconstruction.h>
 #include <pcl/PointIndices.h>
+#include <pcl/Vertices.h>
 #include <pcl/memory.h>
 
 #include <string>
@@ -29,15 +30,28 @@ namespace pcl {
  *  - the interior set grows from the flat points to a fixed point; the rest are
  *    the boundary (undersampled) points.
  *
+ *
+ * The reconstruction (reconstruct()) is the Co-cone algorithm in which only interior
+ * points choose triangles: candidate triangles whose dual Voronoi edges meet the
+ * co-cones of their interior vertices, an umbrella check, pruning of sharp edges
+ * that never touches a boundary point, and a walk over the outside of the
+ * candidates in every connected component. Holes and open borders stay open. The
+ * walk's defects next to boundary points are repaired locally (see
+ * getReconstructionCounts()), so the output is always an oriented 2-manifold with
+ * boundary, closed components facing outward.
+ *
  * \code
  * pcl::CoConeBoundary<pcl::PointXYZ> cocone;
  * cocone.setInputCloud (cloud);
+ * pcl::PolygonMesh mesh;
+ * cocone.reconstruct (mesh);
  * pcl::PointIndices boundary;
- * cocone.detectBoundary (boundary);
+ * cocone.getBoundaryPointIndices (boundary);
  * \endcode
  *
  * Non-finite points are skipped and exact duplicates share one Delaunay vertex;
- * every index this class returns refers to the input cloud.
+ * every index this class returns refers to the input cloud, also with setIndices().
+ * The mesh's cloud is the whole input cloud with all its fields.
  *
  * \ingroup surface
  */
@@ -46,8 +60,6 @@ class CoConeBoundary : public SurfaceReconstruction<PointInT> {
 public:
   using Ptr = shared_ptr<CoConeBoundary<PointInT>>;
   using ConstPtr = shared_ptr<const CoConeBoundary<PointInT>>;
-
-  using SurfaceReconstruction<PointInT>::reconstruct;
 
   /** \brief Constructor: the paper's defaults (rho = 1.5, theta = pi / 6, co-cone
    * angle 3 pi / 8). */
@@ -123,6 +135,32 @@ public:
     return parameters_.boundary_detection;
   }
 
+  /** \brief Set the number of threads (PCL convention: 0 = all processors).
+   *
+   * The output does not depend on it. The stages currently run on one thread; the
+   * setting is kept for the parallel stages.
+   * \param[in] nr_threads number of threads, 0 for all (default 1)
+   */
+  void
+  setNumberOfThreads(unsigned int nr_threads = 0)
+  {
+    threads_ = nr_threads;
+  }
+
+  /** \brief The number of threads set (0 = all processors). */
+  unsigned int
+  getNumberOfThreads() const
+  {
+    return threads_;
+  }
+
+  /** \brief Number of distinct finite points (Delaunay vertices) of the last run. */
+  std::size_t
+  getNumberOfUniquePoints() const
+  {
+    return result_.vertices;
+  }
+
   /** \brief Detect the undersampled points (stages 1-3: Delaunay triangulation,
    * Voronoi cell geometry, flatness and growth), without building a mesh.
    * \param[out] boundary indices into the input cloud, ascending; empty on error
@@ -131,12 +169,54 @@ public:
   bool
   detectBoundary(pcl::PointIndices& boundary);
 
-  /** \brief The undersampled points found by the last run, indices into the input
-   * cloud, ascending.
+  /** \brief The undersampled points of the last run, indices into the input cloud,
+   * ascending: the boundary set B of the detection, and after reconstruct() also the
+   * points that failed the umbrella check.
    * \param[out] boundary the indices
    */
   void
   getBoundaryPointIndices(pcl::PointIndices& boundary) const;
+
+  /** \brief The borders of the last reconstructed mesh as closed loops of input
+   * indices, each ordered with the mesh on its left.
+   *
+   * Not the same as the undersampled points: a point next to a sharp crease is
+   * undersampled, yet the mesh may pass over it.
+   * \param[out] loops one pcl::Vertices per border
+   */
+  void
+  getBoundaryLoops(std::vector<pcl::Vertices>& loops) const;
+
+  /** \brief Oriented normals from the last reconstruction: the pole direction of
+   * every point, turned to the side its mesh faces. A normal estimate with no
+   * neighbourhood parameter.
+   * \param[out] normals one per input point; NaN for points not in the mesh
+   */
+  void
+  getPointNormals(pcl::PointCloud<pcl::Normal>& normals) const;
+
+  /** \brief Sizes of the intermediate results of the last reconstruction, including
+   * what the manifold repair changed. */
+  const cocone::ReconstructionCounts&
+  getReconstructionCounts() const
+  {
+    return result_.counts;
+  }
+
+  /** \brief Reconstruct a mesh; with no input set, log an error and return an empty
+   * mesh (the base class would dereference the missing cloud).
+   * \param[out] output the mesh: the whole input cloud and triangles indexing it
+   */
+  void
+  reconstruct(pcl::PolygonMesh& output) override;
+
+  /** \brief Reconstruct a mesh as points and polygons.
+   * \param[out] points a copy of the whole input cloud
+   * \param[out] polygons triangles indexing \a points
+   */
+  void
+  reconstruct(pcl::PointCloud<PointInT>& points,
+              std::vector<pcl::Vertices>& polygons) override;
 
   /** \brief Wall-clock time of each stage of the last run, in milliseconds. */
   const cocone::Timings&
@@ -158,11 +238,9 @@ protected:
     return "CoConeBoundary";
   }
 
-  /** \brief Not yet available: reconstruction lands with part 2. */
   void
   performReconstruction(pcl::PolygonMesh& output) override;
 
-  /** \brief Not yet available: reconstruction lands with part 2. */
   void
   performReconstruction(pcl::PointCloud<PointInT>& points,
                         std::vector<pcl::Vertices>& polygons) override;
@@ -172,9 +250,18 @@ private:
   bool
   compute(cocone::Stages stages, const char* caller);
 
+  /** Append the mesh's triangles. */
+  void
+  fillPolygons(std::vector<pcl::Vertices>& polygons) const;
+
   cocone::Parameters parameters_;
+  unsigned int threads_ = 1;
   cocone::Timings timings_;
-  pcl::Indices boundary_indices_;
+  /** The last run: its core result and the cloud size it was indexed against. */
+  cocone::Result result_;
+  /** Input index of each point passed to the core in the last run. */
+  std::vector<int> ids_;
+  std::size_t cloud_size_ = 0;
 };
 
 } // namespace pcl

@@ -10,6 +10,7 @@
 #include <pcl/surface/cocone_boundary.h>
 
 #include <cmath>
+#include <limits>
 
 namespace pcl {
 
@@ -69,12 +70,13 @@ template <typename PointInT>
 bool
 CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
 {
-  boundary_indices_.clear();
+  result_ = cocone::Result();
   timings_ = cocone::Timings();
+  cloud_size_ = input_->size();
   std::vector<Eigen::Vector3d> points;
-  std::vector<int> ids;
+  ids_.clear();
   points.reserve(indices_->size());
-  ids.reserve(indices_->size());
+  ids_.reserve(indices_->size());
   for (const auto i : *indices_) {
     if (i < 0 || static_cast<std::size_t>(i) >= input_->size()) {
       PCL_ERROR("[pcl::%s::%s] Index %d is outside the input cloud (%zu points).\n",
@@ -86,33 +88,33 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
     }
     const PointInT& p = (*input_)[i];
     points.emplace_back(p.x, p.y, p.z);
-    ids.push_back(static_cast<int>(i));
+    ids_.push_back(static_cast<int>(i));
   }
 
-  cocone::Result result = cocone::run(points, parameters_, stages, ids);
-  timings_ = result.timings;
-  if (!result.error.empty()) {
+  result_ = cocone::run(points, parameters_, stages, ids_);
+  timings_ = result_.timings;
+  if (!result_.error.empty()) {
     PCL_ERROR("[pcl::%s::%s] No result: %s.\n",
               getClassName().c_str(),
               caller,
-              result.error.c_str());
+              result_.error.c_str());
+    result_ = cocone::Result();
     return false;
   }
-  boundary_indices_.assign(result.boundary_indices.begin(),
-                           result.boundary_indices.end());
   PCL_DEBUG("[pcl::%s::%s] %zu points, %zu unique; timings (ms): unique %.1f, "
             "Delaunay %.1f, Voronoi %.1f, boundary %.1f, reconstruction %.1f; "
-            "%zu boundary points.\n",
+            "%zu boundary points, %zu triangles.\n",
             getClassName().c_str(),
             caller,
             points.size(),
-            result.vertices,
+            result_.vertices,
             timings_.unique,
             timings_.delaunay,
             timings_.voronoi,
             timings_.boundary,
             timings_.reconstruction,
-            boundary_indices_.size());
+            result_.boundary_indices.size(),
+            result_.triangles.size());
   return true;
 }
 
@@ -121,20 +123,18 @@ bool
 CoConeBoundary<PointInT>::detectBoundary(pcl::PointIndices& boundary)
 {
   boundary.indices.clear();
+  result_ = cocone::Result();
   if (!input_) {
     PCL_ERROR("[pcl::%s::detectBoundary] No input cloud was set.\n",
               getClassName().c_str());
-    boundary_indices_.clear();
     return false;
   }
   boundary.header = input_->header;
-  if (!initCompute()) {
-    boundary_indices_.clear();
+  if (!initCompute())
     return false;
-  }
   const bool ok = compute(cocone::Stages::BOUNDARY_DETECTION, "detectBoundary");
   deinitCompute();
-  boundary.indices = boundary_indices_;
+  getBoundaryPointIndices(boundary);
   return ok;
 }
 
@@ -144,7 +144,85 @@ CoConeBoundary<PointInT>::getBoundaryPointIndices(pcl::PointIndices& boundary) c
 {
   if (input_)
     boundary.header = input_->header;
-  boundary.indices = boundary_indices_;
+  boundary.indices = pcl::Indices(result_.boundary_indices);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::getBoundaryLoops(std::vector<pcl::Vertices>& loops) const
+{
+  loops.clear();
+  for (const auto& loop : result_.border_loops) {
+    pcl::Vertices v;
+    v.vertices = pcl::Indices(loop);
+    loops.push_back(std::move(v));
+  }
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::getPointNormals(pcl::PointCloud<pcl::Normal>& normals) const
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  normals.clear();
+  normals.resize(cloud_size_, pcl::Normal(nan, nan, nan, nan));
+  normals.is_dense = false;
+  if (input_)
+    normals.header = input_->header;
+  if (result_.normals.empty())
+    return;
+  for (std::size_t i = 0; i < ids_.size(); ++i) {
+    const int v = result_.vertex_of_input[i];
+    if (v < 0 || !std::isfinite(result_.normals[v].x()))
+      continue;
+    const Eigen::Vector3d& n = result_.normals[v];
+    normals[ids_[i]] = pcl::Normal(static_cast<float>(n.x()),
+                                  static_cast<float>(n.y()),
+                                  static_cast<float>(n.z()),
+                                  0.0f);
+  }
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::fillPolygons(std::vector<pcl::Vertices>& polygons) const
+{
+  polygons.reserve(polygons.size() + result_.polygons.size());
+  for (const auto& t : result_.polygons) {
+    pcl::Vertices v;
+    v.vertices = {t[0], t[1], t[2]};
+    polygons.push_back(std::move(v));
+  }
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::reconstruct(pcl::PolygonMesh& output)
+{
+  if (!input_) {
+    PCL_ERROR("[pcl::%s::reconstruct] No input cloud was set.\n",
+              getClassName().c_str());
+    result_ = cocone::Result();
+    output = pcl::PolygonMesh();
+    return;
+  }
+  SurfaceReconstruction<PointInT>::reconstruct(output);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::reconstruct(pcl::PointCloud<PointInT>& points,
+                                      std::vector<pcl::Vertices>& polygons)
+{
+  if (!input_) {
+    PCL_ERROR("[pcl::%s::reconstruct] No input cloud was set.\n",
+              getClassName().c_str());
+    result_ = cocone::Result();
+    points.clear();
+    polygons.clear();
+    return;
+  }
+  SurfaceReconstruction<PointInT>::reconstruct(points, polygons);
 }
 
 template <typename PointInT>
@@ -152,7 +230,13 @@ void
 CoConeBoundary<PointInT>::performReconstruction(pcl::PolygonMesh& output)
 {
   output.polygons.clear();
-  PCL_ERROR("[pcl::%s::reconstruct] Not implemented yet.\n", getClassName().c_str());
+  if (!compute(cocone::Stages::RECONSTRUCTION, "reconstruct")) {
+    // A defined empty result: no cloud, no polygons.
+    output.cloud = pcl::PCLPointCloud2();
+    output.cloud.header = input_->header;
+    return;
+  }
+  fillPolygons(output.polygons);
 }
 
 template <typename PointInT>
@@ -160,9 +244,15 @@ void
 CoConeBoundary<PointInT>::performReconstruction(pcl::PointCloud<PointInT>& points,
                                                 std::vector<pcl::Vertices>& polygons)
 {
-  points.clear();
   polygons.clear();
-  PCL_ERROR("[pcl::%s::reconstruct] Not implemented yet.\n", getClassName().c_str());
+  if (!compute(cocone::Stages::RECONSTRUCTION, "reconstruct")) {
+    points.clear();
+    points.header = input_->header;
+    return;
+  }
+  // The polygons index the whole input cloud, as in the PolygonMesh overload.
+  points = *input_;
+  fillPolygons(polygons);
 }
 
 } // namespace pcl

@@ -1,0 +1,73 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * File input and output of the command-line tool.
+ */
+
+#pragma once
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/PolygonMesh.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cocone_app {
+
+/** Lower-case extension of a path, without the dot ("" if none). */
+std::string
+extension(const std::string& path);
+
+/** Whether the extension names a readable point cloud format. */
+bool
+isInputFormat(const std::string& ext);
+
+/** Whether the extension names a writable mesh format. */
+bool
+isMeshFormat(const std::string& ext);
+
+/** Read a point cloud (.pcd, .ply, .obj, .xyz/.txt/.pts); on failure return false and
+ * say why in \a error. Only the vertices of a mesh file are read. */
+bool
+readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error);
+
+/** The x, y, z fields of every point in double precision (float or double fields). */
+bool
+extractXYZ(const pcl::PCLPointCloud2& cloud,
+           std::vector<Eigen::Vector3d>& xyz,
+           std::string& error);
+
+/** Set a FLOAT32 field per point: overwrite it if the cloud has it, else append it. */
+void
+setFloatField(pcl::PCLPointCloud2& cloud,
+              const std::string& name,
+              const std::vector<float>& values);
+
+/** Append a field of 4-byte values (UINT32 or FLOAT32 bit patterns) per point. */
+void
+appendField(pcl::PCLPointCloud2& cloud,
+            const std::string& name,
+            std::uint8_t datatype,
+            const std::vector<std::uint32_t>& values);
+
+/** Whether the cloud has a colour field (rgb or rgba). */
+bool
+hasColour(const pcl::PCLPointCloud2& cloud);
+
+/** Check before any work that a file can be created at \a path. */
+bool
+checkWritable(const std::string& path, std::string& error);
+
+/** Write a mesh by extension (.vtk, .ply, .obj, .stl) or a cloud (.pcd) through a
+ * temporary file renamed into place: a failure leaves no partial file. */
+bool
+writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& error);
+
+bool
+writeCloud(const std::string& path, const pcl::PCLPointCloud2& cloud, std::string& error);
+
+} // namespace cocone_app

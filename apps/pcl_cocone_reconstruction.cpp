@@ -1,0 +1,379 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * pcl_cocone_reconstruction: reconstruct a mesh from a point cloud and report where
+ * the cloud is undersampled.
+ */
+
+#include <pcl/common/io.h>
+#include <pcl/common/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone_boundary.h>
+#include <pcl/point_types.h>
+
+#include "cloud_io.h"
+#include "screenshot.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+struct Options {
+  std::string input, output;
+  double ratio = 1.5;
+  double normal_angle = M_PI / 6.0;
+  double cocone_angle = 3.0 * M_PI / 8.0;
+  bool boundary_detection = true;
+  int threads = 1;
+  std::string boundary_file, normals_file, report_file, screenshot_file;
+};
+
+void
+printHelp(const char* name)
+{
+  print_info("Reconstruct a surface from a point cloud with the boundary-aware Co-cone\n"
+             "(Dey & Giesen 2001): holes, open borders and sharp features are\n"
+             "detected as undersampled and left open.\n\n");
+  print_info("Syntax: %s INPUT OUTPUT [options]\n\n", name);
+  print_info(
+      "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .xyz/.txt (x y z "
+      "per line)\n"
+      "  OUTPUT  .vtk (legacy, what pcl_viewer opens), .ply, .obj, .stl\n\n"
+      "  -rho R            ratio of the flatness test (default 1.5; larger marks more\n"
+      "                    points as undersampled)\n"
+      "  -theta T          normal angle in radians (default pi/6)\n"
+      "  -cocone_angle A   co-cone angle in radians (default 3pi/8)\n"
+      "  -no_boundary      plain Co-cone, no boundary detection\n"
+      "  -threads N        number of threads, 0 = all cores (default 1)\n"
+      "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
+      "                    index in the field 'index'\n"
+      "  -normals FILE     write the cloud with oriented normals as a .pcd\n"
+      "  -report FILE      write a JSON report\n"
+      "  -screenshot FILE  render mesh and boundary to a .png without a window\n"
+      "  -v / -q           more / less output\n\n"
+      "The mesh keeps every field of the input cloud; unless the input has colours,\n"
+      "undersampled points are coloured red, so 'pcl_viewer OUTPUT.vtk' shows them.\n");
+}
+
+/** Outputs written so far: a failure removes them, so no run leaves half its files. */
+std::vector<std::string> written;
+
+[[noreturn]] void
+fail(const std::string& message)
+{
+  print_error("Error: %s\n", message.c_str());
+  for (const auto& f : written)
+    std::remove(f.c_str());
+  std::exit(1);
+}
+
+double
+parseNumber(int argc, char** argv, const char* option, double fallback)
+{
+  std::string text;
+  if (parse_argument(argc, argv, option, text) < 0)
+    return fallback;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || errno != 0 || !std::isfinite(v))
+    fail(std::string("option ") + option + ": '" + text + "' is not a number");
+  return v;
+}
+
+Options
+parseOptions(int argc, char** argv)
+{
+  Options o;
+  std::vector<std::string> positional;
+  // Options that take a value; everything else starting with '-' is a switch.
+  const char* with_value[] = {"-rho", "-theta", "-cocone_angle", "-threads", "-boundary",
+                              "-normals", "-report", "-screenshot"};
+  const char* switches[] = {"-no_boundary", "-v", "-q", "-h", "--help"};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    bool known = false;
+    for (const char* w : with_value)
+      if (a == w) {
+        known = true;
+        if (++i >= argc)
+          fail("option " + a + " needs a value");
+      }
+    for (const char* s : switches)
+      known = known || a == s;
+    if (known)
+      continue;
+    if (a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])))
+      fail("unknown option '" + a + "'");
+    positional.push_back(a);
+  }
+  if (positional.size() != 2)
+    fail("expected INPUT and OUTPUT (see -h)");
+  o.input = positional[0];
+  o.output = positional[1];
+
+  o.ratio = parseNumber(argc, argv, "-rho", o.ratio);
+  if (!(o.ratio > 0.0))
+    fail("-rho must be positive");
+  o.normal_angle = parseNumber(argc, argv, "-theta", o.normal_angle);
+  if (!(o.normal_angle > 0.0 && o.normal_angle <= M_PI / 2.0))
+    fail("-theta must be in (0, pi/2]");
+  o.cocone_angle = parseNumber(argc, argv, "-cocone_angle", o.cocone_angle);
+  if (!(o.cocone_angle > 0.0 && o.cocone_angle < M_PI / 2.0))
+    fail("-cocone_angle must be in (0, pi/2)");
+  const double threads = parseNumber(argc, argv, "-threads", 1.0);
+  if (threads < 0.0 || threads != std::floor(threads) || threads > 4096)
+    fail("-threads must be a whole number >= 0");
+  o.threads = static_cast<int>(threads);
+  o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
+  parse_argument(argc, argv, "-boundary", o.boundary_file);
+  parse_argument(argc, argv, "-normals", o.normals_file);
+  parse_argument(argc, argv, "-report", o.report_file);
+  parse_argument(argc, argv, "-screenshot", o.screenshot_file);
+
+  if (!cocone_app::isInputFormat(cocone_app::extension(o.input)))
+    fail("unknown input format '" + o.input +
+         "' (use .pcd, .ply, .obj, .xyz or .txt)");
+  if (!cocone_app::isMeshFormat(cocone_app::extension(o.output)))
+    fail("unknown output format '" + o.output + "' (use .vtk, .ply, .obj or .stl)");
+  if (!o.boundary_file.empty() && cocone_app::extension(o.boundary_file) != "pcd")
+    fail("-boundary must name a .pcd file");
+  if (!o.normals_file.empty() && cocone_app::extension(o.normals_file) != "pcd")
+    fail("-normals must name a .pcd file");
+  if (!o.screenshot_file.empty() && cocone_app::extension(o.screenshot_file) != "png")
+    fail("-screenshot must name a .png file");
+  std::string error;
+  for (const auto* f : {&o.output, &o.boundary_file, &o.normals_file, &o.report_file,
+                        &o.screenshot_file})
+    if (!f->empty() && !cocone_app::checkWritable(*f, error))
+      fail(error);
+  return o;
+}
+
+std::string
+jsonList(const std::vector<int>& v)
+{
+  std::ostringstream s;
+  s << '[';
+  for (std::size_t i = 0; i < v.size(); ++i)
+    s << (i ? "," : "") << v[i];
+  s << ']';
+  return s.str();
+}
+
+std::string
+jsonString(const std::string& text)
+{
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\')
+      out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+      out += buf;
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  if (argc < 2 || find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help")) {
+    printHelp(argv[0]);
+    return argc < 2 ? 1 : 0;
+  }
+  if (find_switch(argc, argv, "-v"))
+    setVerbosityLevel(L_DEBUG);
+  else if (find_switch(argc, argv, "-q"))
+    setVerbosityLevel(L_ERROR);
+  const Options o = parseOptions(argc, argv);
+  // Off-screen rendering needs an X server: run again under a virtual one.
+  if (!o.screenshot_file.empty() && !std::getenv("DISPLAY") &&
+      !std::getenv("COCONE_UNDER_XVFB"))
+    cocone_app::reexecUnderXvfb(argc, argv);
+
+  pcl::StopWatch total;
+  pcl::StopWatch watch;
+  std::string error;
+  pcl::PCLPointCloud2 blob;
+  if (!cocone_app::readCloud(o.input, blob, error))
+    fail(error);
+  std::vector<Eigen::Vector3d> xyz;
+  if (!cocone_app::extractXYZ(blob, xyz, error))
+    fail("'" + o.input + "': " + error);
+  const double load_ms = watch.getTime();
+  print_info("Loaded %zu points from %s in %.0f ms.\n", xyz.size(), o.input.c_str(),
+             load_ms);
+
+  // Subtract a common offset in double precision before the library's float points:
+  // georeferenced coordinates keep their precision. The output keeps the input's own
+  // fields and values.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  std::size_t finite = 0;
+  for (const auto& p : xyz)
+    if (p.allFinite()) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      ++finite;
+    }
+  const Eigen::Vector3d offset = finite ? Eigen::Vector3d(0.5 * (lo + hi)) : Eigen::Vector3d::Zero();
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->resize(xyz.size());
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    const Eigen::Vector3d q = xyz[i] - offset;
+    (*cloud)[i].getVector3fMap() = q.cast<float>();
+  }
+  cloud->width = blob.width;
+  cloud->height = blob.height;
+  cloud->is_dense = finite == xyz.size();
+
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  cocone.setRatio(o.ratio);
+  cocone.setNormalAngle(o.normal_angle);
+  cocone.setCoconeAngle(o.cocone_angle);
+  cocone.setBoundaryDetection(o.boundary_detection);
+  cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
+  pcl::PointCloud<pcl::PointXYZ> unused;
+  std::vector<pcl::Vertices> polygons;
+  cocone.reconstruct(unused, polygons);
+  if (cocone.getNumberOfUniquePoints() == 0)
+    fail("no reconstruction: the cloud has fewer than 4 distinct finite points or "
+         "they are collinear");
+  const auto& t = cocone.getTimings();
+  print_info("Delaunay %.0f ms, Voronoi %.0f ms, boundary %.0f ms, reconstruction %.0f "
+             "ms.\n",
+             t.unique + t.delaunay, t.voronoi, t.boundary, t.reconstruction);
+
+  pcl::PointIndices boundary;
+  cocone.getBoundaryPointIndices(boundary);
+  std::vector<pcl::Vertices> loops;
+  cocone.getBoundaryLoops(loops);
+
+  pcl::PolygonMesh mesh;
+  mesh.header = blob.header;
+  mesh.cloud = blob;
+  mesh.polygons = polygons;
+  const std::size_t n = xyz.size();
+  if (!cocone_app::hasColour(blob)) {
+    // Undersampled points red, the rest light grey: pcl_viewer shades the triangles
+    // around the boundary points.
+    std::vector<std::uint32_t> rgb(n, 0xffc8c8c8u);
+    for (const int i : boundary.indices)
+      rgb[i] = 0xffc81e1eu;
+    std::vector<std::uint32_t> bits(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      float f;
+      std::memcpy(&f, &rgb[i], 4);
+      std::memcpy(&bits[i], &f, 4);
+    }
+    cocone_app::appendField(mesh.cloud, "rgb", pcl::PCLPointField::FLOAT32, bits);
+  }
+
+  // Components and border vertices for the report.
+  std::vector<pcl::cocone::Triangle> tris;
+  tris.reserve(polygons.size());
+  for (const auto& p : polygons)
+    tris.push_back({p.vertices[0], p.vertices[1], p.vertices[2]});
+  std::size_t components = 0;
+  pcl::cocone::triangleComponents(tris, &components);
+  std::vector<int> border;
+  for (const auto& l : loops)
+    border.insert(border.end(), l.vertices.begin(), l.vertices.end());
+  std::sort(border.begin(), border.end());
+  border.erase(std::unique(border.begin(), border.end()), border.end());
+  print_info("%zu triangles, %zu components, %zu border loops, %zu undersampled "
+             "points.\n",
+             polygons.size(), components, loops.size(), boundary.indices.size());
+
+  watch.reset();
+  if (!cocone_app::writeMesh(o.output, mesh, error))
+    fail(error);
+  written.push_back(o.output);
+  if (!o.boundary_file.empty()) {
+    pcl::PCLPointCloud2 points;
+    pcl::copyPointCloud(blob, boundary.indices, points);
+    std::vector<std::uint32_t> index(boundary.indices.begin(), boundary.indices.end());
+    cocone_app::appendField(points, "index", pcl::PCLPointField::UINT32, index);
+    if (!cocone_app::writeCloud(o.boundary_file, points, error))
+      fail(error);
+    written.push_back(o.boundary_file);
+  }
+  if (!o.normals_file.empty()) {
+    pcl::PointCloud<pcl::Normal> normals;
+    cocone.getPointNormals(normals);
+    pcl::PCLPointCloud2 out = blob;
+    std::vector<float> c[3];
+    for (const auto& nrm : normals)
+      for (int k = 0; k < 3; ++k)
+        c[k].push_back(nrm.normal[k]);
+    cocone_app::setFloatField(out, "normal_x", c[0]);
+    cocone_app::setFloatField(out, "normal_y", c[1]);
+    cocone_app::setFloatField(out, "normal_z", c[2]);
+    if (!cocone_app::writeCloud(o.normals_file, out, error))
+      fail(error);
+    written.push_back(o.normals_file);
+  }
+  if (!o.screenshot_file.empty() &&
+      !cocone_app::renderScreenshot(mesh, blob, boundary.indices, o.screenshot_file, error))
+    fail(error);
+  if (!o.screenshot_file.empty())
+    written.push_back(o.screenshot_file);
+  const double save_ms = watch.getTime();
+  const double total_ms = total.getTime();
+  print_info("Wrote %s in %.0f ms; total %.0f ms.\n", o.output.c_str(), save_ms, total_ms);
+
+  if (!o.report_file.empty()) {
+    std::ostringstream r;
+    r.precision(17);
+    r << "{\n  \"input\": " << jsonString(o.input) << ",\n  \"points\": " << n
+      << ",\n  \"finite_points\": " << finite
+      << ",\n  \"unique_points\": " << cocone.getNumberOfUniquePoints()
+      << ",\n  \"parameters\": {\"ratio\": " << o.ratio
+      << ", \"normal_angle\": " << o.normal_angle
+      << ", \"cocone_angle\": " << o.cocone_angle
+      << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
+      << ", \"threads\": " << o.threads << "},\n  \"triangles\": " << polygons.size()
+      << ",\n  \"components\": " << components
+      << ",\n  \"boundary_loops\": " << loops.size()
+      << ",\n  \"boundary_indices\": " << jsonList(boundary.indices)
+      << ",\n  \"border_indices\": " << jsonList(border) << ",\n  \"timings_ms\": {"
+      << "\"load\": " << load_ms << ", \"delaunay\": " << t.unique + t.delaunay
+      << ", \"voronoi\": " << t.voronoi << ", \"boundary\": " << t.boundary
+      << ", \"reconstruction\": " << t.reconstruction << ", \"total\": " << total_ms
+      << ", \"save\": " << save_ms << "}\n}\n";
+    const std::string tmp = o.report_file + ".partial";
+    {
+      std::ofstream f(tmp);
+      f << r.str();
+      if (!f)
+        fail("cannot write '" + o.report_file + "'");
+    }
+    if (std::rename(tmp.c_str(), o.report_file.c_str()) != 0) {
+      std::remove(tmp.c_str());
+      fail("cannot write '" + o.report_file + "'");
+    }
+  }
+  return 0;
+}
