@@ -151,8 +151,20 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
   int status = 0;
   bool ok = true;
   try {
-    if (ext == "pcd")
-      status = pcl::io::loadPCDFile(path, cloud);
+    if (ext == "pcd") {
+      // PCL's reader crashes on some malformed files whose header it rejects: read
+      // the header first.
+      pcl::PCDReader reader;
+      Eigen::Vector4f origin;
+      Eigen::Quaternionf orientation;
+      int version = 0, type = 0;
+      unsigned int data_start = 0;
+      status = reader.readHeader(path, cloud, origin, orientation, version, type, data_start);
+      if (status >= 0 && (cloud.fields.empty() || cloud.point_step == 0))
+        status = -1;
+      if (status >= 0)
+        status = reader.read(path, cloud);
+    }
     else if (ext == "ply")
       status = pcl::io::loadPLYFile(path, cloud);
     else if (ext == "obj")

@@ -1,0 +1,250 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * The command-line tool, run as a user would.
+ */
+
+#include <pcl/io/obj_io.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/io/vtk_lib_io.h>
+#include <pcl/surface/cocone_boundary.h>
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <support/surfaces.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+namespace {
+
+const std::string TOOL = COCONE_TOOL_PATH;
+
+class Tool : public ::testing::Test {
+protected:
+  static void
+  SetUpTestSuite()
+  {
+    char pattern[] = "/tmp/cocone_tool_XXXXXX";
+    dir_ = ::mkdtemp(pattern);
+    cocone_test::SampleOptions o;
+    o.n = 2000;
+    sample_ = new cocone_test::Sample(cocone_test::hemisphere(o));
+    cloud_.reset(new pcl::PointCloud<pcl::PointXYZ>);
+    for (const auto& p : sample_->points)
+      cloud_->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+    pcl::io::savePCDFileBinary(dir_ + "/in.pcd", *cloud_);
+    pcl::io::savePLYFileBinary(dir_ + "/in.ply", *cloud_);
+    std::ofstream xyz(dir_ + "/in.xyz"), txt(dir_ + "/in.txt"), obj(dir_ + "/in.obj");
+    xyz.precision(9);
+    obj.precision(9);
+    for (const auto& p : *cloud_) {
+      xyz << p.x << ' ' << p.y << ' ' << p.z << '\n';
+      obj << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    }
+    txt << "# x y z\n";
+    txt.precision(9);
+    for (const auto& p : *cloud_)
+      txt << p.x << '\t' << p.y << '\t' << p.z << '\n';
+  }
+
+  static void
+  TearDownTestSuite()
+  {
+    std::system(("rm -rf " + dir_).c_str());
+    delete sample_;
+  }
+
+  /** Run the tool; returns its exit code, stderr+stdout in \a output. */
+  static int
+  run(const std::string& args, std::string* output = nullptr)
+  {
+    const std::string log = dir_ + "/log.txt";
+    const int status = std::system((TOOL + " " + args + " > " + log + " 2>&1").c_str());
+    if (output) {
+      std::ifstream f(log);
+      std::stringstream s;
+      s << f.rdbuf();
+      *output = s.str();
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  static bool
+  exists(const std::string& path)
+  {
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0;
+  }
+
+  /** The library's own result on the same cloud. */
+  static std::size_t
+  libraryTriangles(pcl::PointIndices* boundary = nullptr)
+  {
+    pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+    cocone.setInputCloud(cloud_);
+    pcl::PolygonMesh mesh;
+    cocone.reconstruct(mesh);
+    if (boundary)
+      cocone.getBoundaryPointIndices(*boundary);
+    return mesh.polygons.size();
+  }
+
+  static std::string dir_;
+  static cocone_test::Sample* sample_;
+  static pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_;
+};
+
+std::string Tool::dir_;
+cocone_test::Sample* Tool::sample_ = nullptr;
+pcl::PointCloud<pcl::PointXYZ>::Ptr Tool::cloud_;
+
+} // namespace
+
+TEST_F(Tool, EveryInputFormatGivesTheLibraryResult)
+{
+  const std::size_t expected = libraryTriangles();
+  ASSERT_GT(expected, 3000u);
+  for (const std::string in : {"in.pcd", "in.ply", "in.obj", "in.xyz", "in.txt"}) {
+    std::string out;
+    ASSERT_EQ(run(dir_ + "/" + in + " " + dir_ + "/out.vtk -q", &out), 0) << in << out;
+    pcl::PolygonMesh mesh;
+    ASSERT_GT(pcl::io::loadPolygonFileVTK(dir_ + "/out.vtk", mesh), 0) << in;
+    EXPECT_EQ(mesh.polygons.size(), expected) << in;
+    EXPECT_EQ(std::size_t(mesh.cloud.width) * mesh.cloud.height, cloud_->size()) << in;
+  }
+}
+
+TEST_F(Tool, EveryOutputFormatReadsBack)
+{
+  const std::size_t expected = libraryTriangles();
+  for (const std::string ext : {"vtk", "ply", "obj", "stl"}) {
+    const std::string out = dir_ + "/mesh." + ext;
+    ASSERT_EQ(run(dir_ + "/in.pcd " + out + " -q"), 0) << ext;
+    pcl::PolygonMesh mesh;
+    if (ext == "ply")
+      ASSERT_EQ(pcl::io::loadPLYFile(out, mesh), 0);
+    else if (ext == "obj")
+      ASSERT_EQ(pcl::io::loadOBJFile(out, mesh), 0);
+    else
+      ASSERT_GT(pcl::io::loadPolygonFile(out, mesh), 0) << ext;
+    EXPECT_EQ(mesh.polygons.size(), expected) << ext;
+    // Every polygon is a triangle of distinct vertices inside the cloud.
+    const std::size_t n = std::size_t(mesh.cloud.width) * mesh.cloud.height;
+    for (const auto& p : mesh.polygons) {
+      ASSERT_EQ(p.vertices.size(), 3u);
+      for (const auto v : p.vertices)
+        ASSERT_LT(std::size_t(v), n);
+    }
+  }
+}
+
+TEST_F(Tool, ReportAgreesWithTheLibrary)
+{
+  pcl::PointIndices boundary;
+  const std::size_t triangles = libraryTriangles(&boundary);
+  const std::string report = dir_ + "/report.json";
+  ASSERT_EQ(run(dir_ + "/in.pcd " + dir_ + "/m.vtk -q -report " + report +
+                " -boundary " + dir_ + "/b.pcd -normals " + dir_ + "/n.pcd"),
+            0);
+  std::ifstream f(report);
+  std::stringstream s;
+  s << f.rdbuf();
+  const std::string json = s.str();
+  for (const char* key :
+       {"\"input\"", "\"points\"", "\"finite_points\"", "\"unique_points\"",
+        "\"parameters\"", "\"ratio\"", "\"normal_angle\"", "\"cocone_angle\"",
+        "\"boundary_detection\"", "\"threads\"", "\"triangles\"", "\"components\"",
+        "\"boundary_loops\"", "\"boundary_indices\"", "\"border_indices\"",
+        "\"timings_ms\"", "\"load\"", "\"delaunay\"", "\"voronoi\"", "\"boundary\"",
+        "\"reconstruction\"", "\"total\"", "\"save\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+  EXPECT_NE(json.find("\"triangles\": " + std::to_string(triangles) + ","),
+            std::string::npos);
+  EXPECT_NE(json.find("\"points\": " + std::to_string(cloud_->size()) + ","),
+            std::string::npos);
+  EXPECT_NE(json.find("\"boundary_loops\": 1,"), std::string::npos);
+  std::string list;
+  for (std::size_t i = 0; i < boundary.indices.size(); ++i)
+    list += (i ? "," : "") + std::to_string(boundary.indices[i]);
+  EXPECT_NE(json.find("\"boundary_indices\": [" + list + "]"), std::string::npos);
+
+  // The boundary file holds exactly those points, with their input indices.
+  pcl::PCLPointCloud2 b;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/b.pcd", b), 0);
+  EXPECT_EQ(std::size_t(b.width) * b.height, boundary.indices.size());
+  EXPECT_GE(pcl::getFieldIndex(b, "index"), 0);
+  pcl::PointCloud<pcl::PointNormal> normals;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/n.pcd", normals), 0);
+  EXPECT_EQ(normals.size(), cloud_->size());
+  // The hemisphere's normals point away from its centre.
+  std::size_t outward = 0;
+  for (const auto& p : normals)
+    outward += p.normal_x * p.x + p.normal_y * p.y + p.normal_z * p.z > 0.0f;
+  EXPECT_GE(outward, normals.size() * 99 / 100);
+}
+
+TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
+{
+  const std::string out = dir_ + "/err.vtk";
+  std::remove(out.c_str());
+  // A cloud without x/y/z.
+  {
+    pcl::PointCloud<pcl::Intensity> c;
+    c.resize(10);
+    pcl::io::savePCDFileASCII(dir_ + "/noxyz.pcd", c);
+  }
+  std::ofstream(dir_ + "/empty.xyz").close();
+  std::ofstream(dir_ + "/bad.xyz") << "1 2 3\n4 five 6\n";
+  std::ofstream(dir_ + "/bad.pcd") << "this is not a point cloud\n";
+  std::ofstream(dir_ + "/line.xyz") << "0 0 0\n1 1 1\n2 2 2\n3 3 3\n4 4 4\n";
+  const std::string in = dir_ + "/in.pcd ";
+  const std::pair<std::string, std::string> cases[] = {
+      {dir_ + "/missing.pcd " + out, "cannot read"},
+      {dir_ + "/in.las " + out, "unknown input format"},
+      {in + dir_ + "/out.xyz", "unknown output format"},
+      {dir_ + "/noxyz.pcd " + out, "no 'x' field"},
+      {dir_ + "/empty.xyz " + out, "cannot read"},
+      {dir_ + "/bad.xyz " + out, "line 2"},
+      {dir_ + "/bad.pcd " + out, "cannot read"},
+      {dir_ + "/line.xyz " + out, "collinear"},
+      {in + out + " -rho abc", "not a number"},
+      {in + out + " -rho -1", "-rho must be positive"},
+      {in + out + " -theta 3", "-theta"},
+      {in + out + " -threads 1.5", "-threads"},
+      {in + out + " -rho", "needs a value"},
+      {in + out + " -frobnicate", "unknown option"},
+      {in + "/nonexistent-dir/out.vtk", "cannot write"},
+      {in + out + " -boundary " + dir_ + "/b.txt", ".pcd"},
+      {in, "expected INPUT and OUTPUT"},
+  };
+  for (const auto& c : cases) {
+    std::string log;
+    EXPECT_NE(run(c.first, &log), 0) << c.first;
+    EXPECT_NE(log.find(c.second), std::string::npos) << c.first << ": " << log;
+    EXPECT_NE(log.find("Error"), std::string::npos) << c.first;
+    EXPECT_FALSE(exists(out)) << c.first << " left " << out;
+  }
+}
+
+TEST_F(Tool, ScreenshotIsNotBlank)
+{
+  const std::string png = dir_ + "/shot.png";
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/in.pcd " + dir_ + "/s.vtk -q -screenshot " + png, &log), 0)
+      << log;
+  std::ifstream f(png, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 24u);
+  EXPECT_EQ(bytes.substr(1, 3), "PNG");
+  // A blank 1024 x 768 frame compresses to a few kilobytes; a rendered mesh does not.
+  EXPECT_GT(bytes.size(), 20000u);
+}
