@@ -56,7 +56,8 @@ detect(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud, bool* ok = nullptr)
 TEST(CoConeBoundary, DefaultsAndSetterValidation)
 {
   pcl::CoConeBoundary<pcl::PointXYZ> cocone;
-  EXPECT_DOUBLE_EQ(cocone.getRatio(), 1.5);
+  EXPECT_DOUBLE_EQ(cocone.getRatio(), 0.0); // automatic
+  EXPECT_DOUBLE_EQ(cocone.getSpacingFactor(), 3.0);
   EXPECT_DOUBLE_EQ(cocone.getNormalAngle(), M_PI / 6.0);
   EXPECT_DOUBLE_EQ(cocone.getCoconeAngle(), 3.0 * M_PI / 8.0);
   EXPECT_TRUE(cocone.getBoundaryDetection());
@@ -64,7 +65,12 @@ TEST(CoConeBoundary, DefaultsAndSetterValidation)
   EXPECT_DOUBLE_EQ(cocone.getRatio(), 2.5);
   cocone.setRatio(-1.0);
   cocone.setRatio(std::numeric_limits<double>::quiet_NaN());
+  cocone.setRatio(std::numeric_limits<double>::infinity());
   EXPECT_DOUBLE_EQ(cocone.getRatio(), 2.5);
+  cocone.setSpacingFactor(-1.0);
+  EXPECT_DOUBLE_EQ(cocone.getSpacingFactor(), 3.0);
+  cocone.setSpacingFactor(0.0);
+  EXPECT_DOUBLE_EQ(cocone.getSpacingFactor(), 0.0);
   cocone.setNormalAngle(0.0);
   cocone.setNormalAngle(2.0);
   EXPECT_DOUBLE_EQ(cocone.getNormalAngle(), M_PI / 6.0);
@@ -198,23 +204,19 @@ TEST(CoConeBoundary, IndicesSelectASubsetAndRefertoTheCloud)
 
 TEST(CoConeBoundary, FlatWallHasItsOutlineAsBoundary)
 {
-  // A jittered planar grid (a wall scan): outline points are boundary, inner points
-  // interior.
+  // An exactly planar wall scan, tilted (the plane z = x + 2 y / 4 holds exactly in
+  // float for these dyadic coordinates), interior jittered in the plane: its outline
+  // points are boundary, its inner points interior.
   std::vector<Eigen::Vector3d> pts;
   const int nx = 60, ny = 40;
   for (int i = 0; i < nx; ++i)
     for (int j = 0; j < ny; ++j) {
-      const double jx = 0.2 * std::sin(i * 12.9898 + j * 78.233);
-      const double jy = 0.2 * std::cos(i * 39.3468 + j * 11.135);
       const bool edge = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
-      // Keep the outline straight so that it is the convex hull.
-      pts.emplace_back(edge ? i : i + jx, edge ? j : j + jy, 0.0);
+      const double jx = edge ? 0.0 : ((i * 7 + j * 13) % 9 - 4) / 32.0;
+      const double jy = edge ? 0.0 : ((i * 11 + j * 5) % 9 - 4) / 32.0;
+      const double x = i + jx, y = j + jy;
+      pts.emplace_back(x, y, x + y / 2.0);
     }
-  // Tilt the wall so that it is no coordinate plane.
-  const Eigen::Matrix3d R =
-      Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  for (auto& p : pts)
-    p = R * p;
   const auto boundary = detect(toCloud<pcl::PointXYZ>(pts));
   std::vector<bool> is_boundary(pts.size(), false);
   for (const int i : boundary)

@@ -6,21 +6,93 @@
 #include <pcl/surface/cocone/boundary.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace pcl {
 namespace cocone {
 
+std::vector<double>
+localSpacing(const Triangulation& dt)
+{
+  constexpr int K = 6;
+  const std::size_t n = dt.points.size();
+  // Per vertex its K nearest Delaunay neighbours so far, as (distance, id).
+  std::vector<std::array<std::pair<double, int>, K>> near(n);
+  for (auto& a : near)
+    a.fill({std::numeric_limits<double>::infinity(), -1});
+  const auto offer = [&](int a, int b, double d) {
+    auto& list = near[a];
+    if (d >= list[K - 1].first)
+      return;
+    for (const auto& e : list)
+      if (e.second == b)
+        return;
+    int k = K - 1;
+    for (; k > 0 && list[k - 1].first > d; --k)
+      list[k] = list[k - 1];
+    list[k] = {d, b};
+  };
+  const int corners = dt.dimension == 2 ? 3 : 4;
+  for (const auto& cell : dt.cells)
+    for (int i = 0; i < corners; ++i)
+      for (int j = i + 1; j < corners; ++j) {
+        const double d = (dt.points[cell[i]] - dt.points[cell[j]]).norm();
+        offer(cell[i], cell[j], d);
+        offer(cell[j], cell[i], d);
+      }
+  std::vector<double> mean(n, 0.0);
+  for (std::size_t v = 0; v < n; ++v) {
+    int count = 0;
+    for (const auto& e : near[v])
+      if (e.second >= 0) {
+        mean[v] += e.first;
+        ++count;
+      }
+    mean[v] = count ? mean[v] / count : 0.0;
+  }
+  std::vector<double> s = mean;
+  for (std::size_t v = 0; v < n; ++v)
+    for (const auto& e : near[v])
+      if (e.second >= 0)
+        s[v] = std::max(s[v], mean[e.second]);
+  return s;
+}
+
+double
+automaticRatio(const VoronoiCells& cells)
+{
+  std::vector<double> r;
+  r.reserve(cells.width.size());
+  for (std::size_t v = 0; v < cells.width.size(); ++v) {
+    const double q = cells.width[v] / cells.height(v);
+    if (std::isfinite(q) && cells.height(v) > 0.0)
+      r.push_back(q);
+  }
+  if (r.empty())
+    return 1.5;
+  const std::size_t k = (r.size() - 1) * 95 / 100;
+  std::nth_element(r.begin(), r.begin() + k, r.end());
+  const double q95 = r[k];
+  return q95 > 0.0 ? std::clamp(1.0 / (2.0 * q95), 0.5, 4.0) : 4.0;
+}
+
 BoundaryLabels
-detectBoundary(const VoronoiCells& cells, const FlatnessParameters& parameters)
+detectBoundary(const VoronoiCells& cells,
+               const FlatnessParameters& parameters,
+               const std::vector<double>& spacing)
 {
   const std::size_t n = cells.pole.size();
   BoundaryLabels out;
+  out.ratio = parameters.ratio > 0.0 ? parameters.ratio : automaticRatio(cells);
+  const double a = spacing.size() == n ? parameters.spacing_factor : 0.0;
   out.ratio_ok.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
     const double w = cells.width[v];
-    out.ratio_ok[v] = std::isfinite(w) && parameters.ratio * w <= cells.height(v);
+    out.ratio_ok[v] = std::isfinite(w) && out.ratio * w <= cells.height(v) &&
+                      (a <= 0.0 || w <= a * spacing[v]);
   }
 
   // Angles are between pole lines: compare |cos|.

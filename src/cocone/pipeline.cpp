@@ -68,6 +68,7 @@ reconstruct(const Triangulation& dt,
   counts.walk_components = walked.components;
   counts.walked = walked.triangles.size();
   counts.walk_conflicts = walked.conflicts;
+  counts.walk_reseeds = walked.reseeds;
 
   result.triangles = std::move(walked.triangles);
   repairManifold(dt.points, result.triangles, counts.repair);
@@ -146,8 +147,13 @@ run(const std::vector<Eigen::Vector3d>& points,
 
   result.boundary.assign(result.vertices, 0);
   if (parameters.boundary_detection) {
-    const BoundaryLabels labels =
-        detectBoundary(cells, {parameters.ratio, parameters.normal_angle});
+    const std::vector<double> spacing =
+        parameters.spacing_factor > 0.0 ? localSpacing(dt) : std::vector<double>();
+    const BoundaryLabels labels = detectBoundary(
+        cells,
+        {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
+        spacing);
+    result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];
   }

@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numeric>
 #include <utility>
 
@@ -73,13 +75,57 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     return lexLess(input[a], input[b]) || (input[a] == input[b] && a < b);
   });
 
-  UniquePoints out;
-  out.vertex_of_input.assign(input.size(), -1);
+  std::vector<Eigen::Vector3d> sorted;
+  std::vector<int> sorted_of_input(input.size(), -1);
   for (const int i : order) {
-    if (out.points.empty() || out.points.back() != input[i])
-      out.points.push_back(input[i]);
-    out.vertex_of_input[i] = static_cast<int>(out.points.size()) - 1;
+    if (sorted.empty() || sorted.back() != input[i])
+      sorted.push_back(input[i]);
+    sorted_of_input[i] = static_cast<int>(sorted.size()) - 1;
   }
+
+  // Number the vertices along a Morton (Z-order) curve, ties in lexicographic order:
+  // neighbours in space get nearby ids, which keeps the per-cell passes cache
+  // friendly, and the numbering still depends only on the point set.
+  UniquePoints out;
+  if (sorted.empty()) {
+    out.vertex_of_input.assign(input.size(), -1);
+    return out;
+  }
+  Eigen::Vector3d lo = sorted.front(), hi = sorted.front();
+  for (const auto& p : sorted) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = std::max((hi - lo).maxCoeff(), std::numeric_limits<double>::min());
+  const auto spread = [](std::uint64_t v) { // 21 bits -> every third bit
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  std::vector<std::pair<std::uint64_t, int>> keys(sorted.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    std::uint64_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double t = (sorted[i][k] - lo[k]) / extent * 2097151.0;
+      code |= spread(static_cast<std::uint64_t>(std::clamp(t, 0.0, 2097151.0))) << k;
+    }
+    keys[i] = {code, static_cast<int>(i)};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> vertex_of_sorted(sorted.size());
+  out.points.resize(sorted.size());
+  for (std::size_t v = 0; v < keys.size(); ++v) {
+    vertex_of_sorted[keys[v].second] = static_cast<int>(v);
+    out.points[v] = sorted[keys[v].second];
+  }
+  out.vertex_of_input.resize(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i)
+    out.vertex_of_input[i] =
+        sorted_of_input[i] < 0 ? -1 : vertex_of_sorted[sorted_of_input[i]];
   return out;
 }
 

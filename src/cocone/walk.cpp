@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -115,11 +116,37 @@ walk(const TriangleComplex& complex,
     int x, y, t;
   };
   std::vector<Pending> pending;
-  for (const int s : seeds) {
+  // After one walk per component, a walk from every present triangle none of whose
+  // vertices the surface uses yet: a component joined to another by stray
+  // candidate triangles that the walk does not cross still gets its own walk.
+  std::vector<std::uint8_t> used(complex.points().size(), 0);
+  std::vector<int> reseeds;
+  for (int t = 0; t < m; ++t)
+    if (present[t])
+      reseeds.push_back(t);
+  std::stable_sort(reseeds.begin(), reseeds.end(), [&](int a, int b) {
+    return score(a) > score(b);
+  });
+  std::size_t next_component = 0, next_reseed = 0;
+  const auto next_seed = [&]() {
+    if (next_component < seeds.size())
+      return seeds[next_component++];
+    for (; next_reseed < reseeds.size(); ++next_reseed) {
+      const int t = reseeds[next_reseed];
+      const auto& v = complex.triangle(t);
+      if (!in_surface[t] && !used[v[0]] && !used[v[1]] && !used[v[2]]) {
+        ++out.reseeds;
+        return t;
+      }
+    }
+    return -1;
+  };
+  for (int s = next_seed(); s >= 0; s = next_seed()) {
     const auto& v = complex.triangle(s);
     oriented[s] = v;
     in_surface[s] = 1;
     out.triangles.push_back(v);
+    used[v[0]] = used[v[1]] = used[v[2]] = 1;
     pending = {{v[2], v[0], s}, {v[1], v[2], s}, {v[0], v[1], s}};
     while (!pending.empty()) {
       const Pending p = pending.back();
@@ -146,6 +173,7 @@ walk(const TriangleComplex& complex,
       oriented[t2] = next;
       in_surface[t2] = 1;
       out.triangles.push_back(next);
+      used[a] = 1;
       pending.push_back({a, p.y, t2});
       pending.push_back({p.x, a, t2});
     }

@@ -3,9 +3,9 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 
-#include <support/metrics.h>
-
 #include <Eigen/Geometry>
+
+#include <support/metrics.h>
 
 #include <cmath>
 #include <cstdio>
@@ -182,9 +182,10 @@ scoreMesh(const Sample& s, const pcl::cocone::Result& r)
   score.used_share = s.points.empty() ? 0.0 : double(count) / double(s.points.size());
   for (const auto& t : r.polygons) {
     const Eigen::Vector3d a = s.points[t[0]], b = s.points[t[1]], c = s.points[t[2]];
-    for (const Eigen::Vector3d& q :
-         {Eigen::Vector3d((a + b + c) / 3.0), Eigen::Vector3d((a + b) / 2.0),
-          Eigen::Vector3d((b + c) / 2.0), Eigen::Vector3d((c + a) / 2.0)})
+    for (const Eigen::Vector3d& q : {Eigen::Vector3d((a + b + c) / 3.0),
+                                     Eigen::Vector3d((a + b) / 2.0),
+                                     Eigen::Vector3d((b + c) / 2.0),
+                                     Eigen::Vector3d((c + a) / 2.0)})
       score.max_distance = std::max(score.max_distance, s.distance(q) / s.spacing);
     score.volume += a.dot(b.cross(c)) / 6.0;
   }

@@ -8,9 +8,9 @@
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
 
-#include <support/surfaces.h>
-
 #include <Eigen/Core>
+
+#include <support/surfaces.h>
 
 #include <cstdint>
 #include <string>

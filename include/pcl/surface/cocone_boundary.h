@@ -61,26 +61,56 @@ public:
   using Ptr = shared_ptr<CoConeBoundary<PointInT>>;
   using ConstPtr = shared_ptr<const CoConeBoundary<PointInT>>;
 
-  /** \brief Constructor: the paper's defaults (rho = 1.5, theta = pi / 6, co-cone
-   * angle 3 pi / 8). */
+  /** \brief Constructor: the automatic ratio with the spacing test, theta = pi / 6,
+   * co-cone angle 3 pi / 8. */
   CoConeBoundary();
 
   /** \brief Set the ratio rho of the flatness test rho * width <= height.
    *
    * Larger values mark more points as undersampled. The paper uses 1.5 on every data
    * set and reports that 1.1-1.7 work; theory asks for 1 / (1.3 epsilon) on an
-   * epsilon-sample. A hole whose radius is smaller than about the local feature size
-   * divided by rho is taken as well sampled.
-   * \param[in] ratio rho, finite and > 0 (default 1.5)
+   * epsilon-sample, so no fixed value suits every cloud: a hole whose radius is
+   * smaller than about the local feature size divided by rho passes as well sampled.
+   * With 0 (the default) rho is chosen from the cloud as
+   * clamp(1 / (2 Q95(w / h)), 0.5, 4), Q95 the 95th percentile of width / height
+   * over the points; getUsedRatio() tells the value of the last run.
+   * setRatio (1.5) with setSpacingFactor (0) is the paper's test exactly.
+   * \param[in] ratio rho, finite and > 0, or 0 for automatic (default 0)
    */
   void
   setRatio(double ratio);
 
-  /** \brief Get the ratio rho. */
+  /** \brief Get the ratio setting (0 = automatic). */
   double
   getRatio() const
   {
     return parameters_.ratio;
+  }
+
+  /** \brief The ratio rho used by the last run. */
+  double
+  getUsedRatio() const
+  {
+    return result_.ratio;
+  }
+
+  /** \brief Set the spacing factor a: a flat point's Voronoi cell also has
+   * width <= a * s_p, s_p the local sample spacing (the mean distance to the 6
+   * nearest Delaunay neighbours, maximised over the point and those neighbours).
+   *
+   * Interior cells are about one spacing wide (w / s <= 1.3 measured, whatever the
+   * noise or scale), border cells reach out 3 or more: the test finds the borders of
+   * nearly flat sheets and small holes that the scale-free ratio test passes.
+   * \param[in] factor a >= 0; 0 turns the test off (default 3)
+   */
+  void
+  setSpacingFactor(double factor);
+
+  /** \brief Get the spacing factor (0 = off). */
+  double
+  getSpacingFactor() const
+  {
+    return parameters_.spacing_factor;
   }
 
   /** \brief Set the normal angle theta of the flatness test.

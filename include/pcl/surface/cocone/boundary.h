@@ -5,6 +5,7 @@
 
 #pragma once
 
+#include <pcl/surface/cocone/triangulation.h>
 #include <pcl/surface/cocone/voronoi_cell.h>
 
 #include <cstdint>
@@ -15,15 +16,40 @@ namespace cocone {
 
 /** \brief Parameters of the flatness test (Dey & Giesen, Definition 2). */
 struct FlatnessParameters {
-  /** Ratio rho: a flat cell has rho * width <= height. */
+  /** Ratio rho: a flat cell has rho * width <= height. 0: chosen from the cloud,
+   * rho = clamp(1 / (2 Q95(w / h)), 0.5, 4) (see automaticRatio()). */
   double ratio = 1.5;
   /** Normal angle theta (radians): largest angle between the pole lines of p and
    * of every q that has p as a co-cone neighbour. */
   double normal_angle = 0.5235987755982988; // pi / 6
+  /** Spacing factor a: a flat cell also has width <= a * s_p, s_p the local sample
+   * spacing (see localSpacing()); 0 turns this test off (the paper's test). */
+  double spacing_factor = 0.0;
 };
+
+/** \brief Local sample spacing s_p: the mean distance of p to its 6 nearest Delaunay
+ * neighbours, maximised over p and those neighbours.
+ *
+ * The width of an interior Voronoi cell is about the spacing whatever the scale or
+ * the noise (w / s <= 1.3 measured), while at a border the cell reaches out several
+ * spacings (w / s >= 3): unlike w / h, the ratio w / s does not depend on how the
+ * border compares with the local feature size.
+ */
+std::vector<double>
+localSpacing(const Triangulation& dt);
+
+/** \brief The automatic ratio rho = clamp(1 / (2 Q95(w / h)), 0.5, 4).
+ *
+ * Theory ties rho to the sampling density (rho = 1 / (1.3 epsilon)) and w / h of
+ * interior cells is of the order of epsilon: the 95th percentile of w / h over the
+ * cloud measures epsilon with room for the few border points. */
+double
+automaticRatio(const VoronoiCells& cells);
 
 /** \brief Per-vertex outcome of stage 3. */
 struct BoundaryLabels {
+  /** The ratio rho used (the automatic one if FlatnessParameters::ratio was 0). */
+  double ratio = 0.0;
   /** rho * w(V_p) <= h(V_p). */
   std::vector<std::uint8_t> ratio_ok;
   /** The ratio and the normal condition hold (ISFLAT). */
@@ -37,9 +63,16 @@ struct BoundaryLabels {
  * A vertex p joins R through a q already in R that has p as a co-cone neighbour,
  * when p satisfies the ratio condition and the pole lines of p and q make an angle
  * of at most theta. The fixed point does not depend on the order of the growth.
+ *
+ * \param[in] cells stage 2 output
+ * \param[in] parameters rho, theta and the spacing factor
+ * \param[in] spacing per vertex s_p (localSpacing()); needed if the spacing factor
+ *            is not 0
  */
 BoundaryLabels
-detectBoundary(const VoronoiCells& cells, const FlatnessParameters& parameters);
+detectBoundary(const VoronoiCells& cells,
+               const FlatnessParameters& parameters,
+               const std::vector<double>& spacing = {});
 
 } // namespace cocone
 } // namespace pcl

@@ -21,8 +21,11 @@ namespace cocone {
 
 /** \brief Parameters of the whole pipeline. */
 struct Parameters {
-  /** Ratio rho of the flatness test. */
-  double ratio = 1.5;
+  /** Ratio rho of the flatness test; 0: chosen from the cloud (automaticRatio()). */
+  double ratio = 0.0;
+  /** Spacing factor a of the flatness test (width <= a * local spacing); 0: off,
+   * the paper's test. */
+  double spacing_factor = 3.0;
   /** Normal angle theta in radians. */
   double normal_angle = 0.5235987755982988; // pi / 6
   /** Co-cone angle in radians. */
@@ -43,6 +46,7 @@ struct ReconstructionCounts {
   std::size_t walk_components = 0; // stage 7: components of the pruned complex
   std::size_t walked = 0;         // stage 7: triangles the walk kept
   std::size_t walk_conflicts = 0; // stage 7: triangles reached with both orientations
+  std::size_t walk_reseeds = 0;   // stage 7: walks started after one per component
   RepairCounts repair;            // changes by the manifold repair
 };
 
@@ -69,6 +73,8 @@ struct Result {
   std::size_t vertices = 0;
   /** Per vertex: undersampled (not in the interior set of stage 3). */
   std::vector<std::uint8_t> boundary;
+  /** The ratio rho used (the automatic one when Parameters::ratio is 0). */
+  double ratio = 0.0;
   /** Per vertex: failed the umbrella check (stage 5). */
   std::vector<std::uint8_t> umbrella_failed;
   /** Caller ids of the points labelled boundary (B, plus the umbrella failures after

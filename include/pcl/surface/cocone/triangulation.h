@@ -17,11 +17,12 @@ namespace cocone {
 /** \brief The unique finite points of an input, in a canonical order.
  *
  * Exact duplicates become one point (one Delaunay vertex); non-finite points are
- * dropped. The points are sorted lexicographically, so vertex ids, and everything
- * derived from them, do not depend on the order of the input.
+ * dropped. The points are numbered along a Morton curve (ties lexicographically),
+ * so vertex ids, and everything derived from them, depend only on the point set,
+ * not on the order of the input, and neighbours in space have nearby ids.
  */
 struct UniquePoints {
-  /** Unique finite points, lexicographically sorted. */
+  /** Unique finite points in Morton order. */
   std::vector<Eigen::Vector3d> points;
   /** Per input point: its unique point, or -1 if it is not finite. */
   std::vector<int> vertex_of_input;

@@ -21,6 +21,8 @@ struct WalkResult {
   std::size_t components = 0;
   /** Triangles reached again through another edge with the opposite orientation. */
   std::size_t conflicts = 0;
+  /** Extra walks started from triangles the first walks left with no vertex used. */
+  std::size_t reseeds = 0;
 };
 
 /** \brief SURFACENEIGHBOR: the triangle to continue with across edge x->y of the
@@ -42,7 +44,9 @@ surfaceNeighbor(const TriangleComplex& complex,
                 int& apex);
 
 /** \brief Stage 7: WALK, started once in every connected component of the pruned
- * complex, from a triangle whose vertices all have umbrellas where possible.
+ * complex, from a triangle whose vertices all have umbrellas where possible; then
+ * again from every present triangle whose vertices no walk has reached (a component
+ * joined to another only by stray triangles that the walk does not cross).
  *
  * \param[in] complex the candidate triangles
  * \param[in] present per triangle: survived pruning

@@ -25,15 +25,30 @@ template <typename PointInT>
 void
 CoConeBoundary<PointInT>::setRatio(double ratio)
 {
-  if (!std::isfinite(ratio) || ratio <= 0.0) {
-    PCL_ERROR("[pcl::%s::setRatio] The ratio must be finite and positive (got %g); "
-              "keeping %g.\n",
+  if (!std::isfinite(ratio) || ratio < 0.0) {
+    PCL_ERROR("[pcl::%s::setRatio] The ratio must be finite and positive, or 0 for "
+              "automatic (got %g); keeping %g.\n",
               getClassName().c_str(),
               ratio,
               parameters_.ratio);
     return;
   }
   parameters_.ratio = ratio;
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::setSpacingFactor(double factor)
+{
+  if (!std::isfinite(factor) || factor < 0.0) {
+    PCL_ERROR("[pcl::%s::setSpacingFactor] The spacing factor must be finite and >= 0 "
+              "(got %g); keeping %g.\n",
+              getClassName().c_str(),
+              factor,
+              parameters_.spacing_factor);
+    return;
+  }
+  parameters_.spacing_factor = factor;
 }
 
 template <typename PointInT>
@@ -103,7 +118,7 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
   }
   PCL_DEBUG("[pcl::%s::%s] %zu points, %zu unique; timings (ms): unique %.1f, "
             "Delaunay %.1f, Voronoi %.1f, boundary %.1f, reconstruction %.1f; "
-            "%zu boundary points, %zu triangles.\n",
+            "rho %.3f; %zu boundary points, %zu triangles.\n",
             getClassName().c_str(),
             caller,
             points.size(),
@@ -113,6 +128,7 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
             timings_.voronoi,
             timings_.boundary,
             timings_.reconstruction,
+            result_.ratio,
             result_.boundary_indices.size(),
             result_.triangles.size());
   return true;
