@@ -14,6 +14,8 @@
 #include <pcl/io/vtk_lib_io.h>
 #include <pcl/PCLPointField.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -22,7 +24,6 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 namespace cocone_app {
 
@@ -159,7 +160,8 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
       Eigen::Quaternionf orientation;
       int version = 0, type = 0;
       unsigned int data_start = 0;
-      status = reader.readHeader(path, cloud, origin, orientation, version, type, data_start);
+      status = reader.readHeader(
+          path, cloud, origin, orientation, version, type, data_start);
       if (status >= 0 && (cloud.fields.empty() || cloud.point_step == 0))
         status = -1;
       if (status >= 0)
@@ -280,7 +282,8 @@ setFloatField(pcl::PCLPointCloud2& cloud,
 bool
 hasColour(const pcl::PCLPointCloud2& cloud)
 {
-  return pcl::getFieldIndex(cloud, "rgb") >= 0 || pcl::getFieldIndex(cloud, "rgba") >= 0;
+  return pcl::getFieldIndex(cloud, "rgb") >= 0 ||
+         pcl::getFieldIndex(cloud, "rgba") >= 0;
 }
 
 bool
@@ -288,8 +291,8 @@ checkWritable(const std::string& path, std::string& error)
 {
   const std::string dir = directoryOf(path);
   if (::access(dir.c_str(), W_OK) != 0) {
-    error = "cannot write '" + path + "': directory '" + dir + "' " +
-            std::strerror(errno);
+    error =
+        "cannot write '" + path + "': directory '" + dir + "' " + std::strerror(errno);
     return false;
   }
   return true;
@@ -325,7 +328,9 @@ writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& er
 }
 
 bool
-writeCloud(const std::string& path, const pcl::PCLPointCloud2& cloud, std::string& error)
+writeCloud(const std::string& path,
+           const pcl::PCLPointCloud2& cloud,
+           std::string& error)
 {
   if (extension(path) != "pcd") {
     error = "'" + path + "' must be a .pcd file";
@@ -334,8 +339,8 @@ writeCloud(const std::string& path, const pcl::PCLPointCloud2& cloud, std::strin
   const std::string tmp = temporaryName(path);
   const auto verbosity = pcl::console::getVerbosityLevel();
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-  const int status = pcl::io::savePCDFile(tmp, cloud, Eigen::Vector4f::Zero(),
-                                          Eigen::Quaternionf::Identity(), true);
+  const int status = pcl::io::savePCDFile(
+      tmp, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true);
   pcl::console::setVerbosityLevel(verbosity);
   if (status < 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());

@@ -68,6 +68,8 @@ bool
 writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& error);
 
 bool
-writeCloud(const std::string& path, const pcl::PCLPointCloud2& cloud, std::string& error);
+writeCloud(const std::string& path,
+           const pcl::PCLPointCloud2& cloud,
+           std::string& error);
 
 } // namespace cocone_app

@@ -16,6 +16,7 @@
 
 #include "cloud_io.h"
 #include "screenshot.h"
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -25,7 +26,6 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 using namespace pcl::console;
@@ -34,7 +34,8 @@ namespace {
 
 struct Options {
   std::string input, output;
-  double ratio = 1.5;
+  double ratio = 0.0; // automatic
+  double spacing_factor = 3.0;
   double normal_angle = M_PI / 6.0;
   double cocone_angle = 3.0 * M_PI / 8.0;
   bool boundary_detection = true;
@@ -45,16 +46,21 @@ struct Options {
 void
 printHelp(const char* name)
 {
-  print_info("Reconstruct a surface from a point cloud with the boundary-aware Co-cone\n"
-             "(Dey & Giesen 2001): holes, open borders and sharp features are\n"
-             "detected as undersampled and left open.\n\n");
+  print_info(
+      "Reconstruct a surface from a point cloud with the boundary-aware Co-cone\n"
+      "(Dey & Giesen 2001): holes, open borders and sharp features are\n"
+      "detected as undersampled and left open.\n\n");
   print_info("Syntax: %s INPUT OUTPUT [options]\n\n", name);
   print_info(
-      "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .xyz/.txt (x y z "
+      "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .xyz/.txt (x y "
+      "z "
       "per line)\n"
       "  OUTPUT  .vtk (legacy, what pcl_viewer opens), .ply, .obj, .stl\n\n"
-      "  -rho R            ratio of the flatness test (default 1.5; larger marks more\n"
-      "                    points as undersampled)\n"
+      "  -rho R            ratio of the flatness test; 0 (default) chooses it from "
+      "the\n"
+      "                    cloud; the paper uses 1.5; larger marks more points\n"
+      "  -spacing_factor A undersampled if the Voronoi cell is wider than A local\n"
+      "                    spacings (default 3; 0 = the paper's test alone)\n"
       "  -theta T          normal angle in radians (default pi/6)\n"
       "  -cocone_angle A   co-cone angle in radians (default 3pi/8)\n"
       "  -no_boundary      plain Co-cone, no boundary detection\n"
@@ -101,8 +107,15 @@ parseOptions(int argc, char** argv)
   Options o;
   std::vector<std::string> positional;
   // Options that take a value; everything else starting with '-' is a switch.
-  const char* with_value[] = {"-rho", "-theta", "-cocone_angle", "-threads", "-boundary",
-                              "-normals", "-report", "-screenshot"};
+  const char* with_value[] = {"-rho",
+                              "-spacing_factor",
+                              "-theta",
+                              "-cocone_angle",
+                              "-threads",
+                              "-boundary",
+                              "-normals",
+                              "-report",
+                              "-screenshot"};
   const char* switches[] = {"-no_boundary", "-v", "-q", "-h", "--help"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -127,8 +140,11 @@ parseOptions(int argc, char** argv)
   o.output = positional[1];
 
   o.ratio = parseNumber(argc, argv, "-rho", o.ratio);
-  if (!(o.ratio > 0.0))
-    fail("-rho must be positive");
+  if (!(o.ratio >= 0.0))
+    fail("-rho must be positive (or 0 for automatic)");
+  o.spacing_factor = parseNumber(argc, argv, "-spacing_factor", o.spacing_factor);
+  if (!(o.spacing_factor >= 0.0))
+    fail("-spacing_factor must be >= 0");
   o.normal_angle = parseNumber(argc, argv, "-theta", o.normal_angle);
   if (!(o.normal_angle > 0.0 && o.normal_angle <= M_PI / 2.0))
     fail("-theta must be in (0, pi/2]");
@@ -146,8 +162,7 @@ parseOptions(int argc, char** argv)
   parse_argument(argc, argv, "-screenshot", o.screenshot_file);
 
   if (!cocone_app::isInputFormat(cocone_app::extension(o.input)))
-    fail("unknown input format '" + o.input +
-         "' (use .pcd, .ply, .obj, .xyz or .txt)");
+    fail("unknown input format '" + o.input + "' (use .pcd, .ply, .obj, .xyz or .txt)");
   if (!cocone_app::isMeshFormat(cocone_app::extension(o.output)))
     fail("unknown output format '" + o.output + "' (use .vtk, .ply, .obj or .stl)");
   if (!o.boundary_file.empty() && cocone_app::extension(o.boundary_file) != "pcd")
@@ -157,7 +172,10 @@ parseOptions(int argc, char** argv)
   if (!o.screenshot_file.empty() && cocone_app::extension(o.screenshot_file) != "png")
     fail("-screenshot must name a .png file");
   std::string error;
-  for (const auto* f : {&o.output, &o.boundary_file, &o.normals_file, &o.report_file,
+  for (const auto* f : {&o.output,
+                        &o.boundary_file,
+                        &o.normals_file,
+                        &o.report_file,
                         &o.screenshot_file})
     if (!f->empty() && !cocone_app::checkWritable(*f, error))
       fail(error);
@@ -222,8 +240,8 @@ main(int argc, char** argv)
   if (!cocone_app::extractXYZ(blob, xyz, error))
     fail("'" + o.input + "': " + error);
   const double load_ms = watch.getTime();
-  print_info("Loaded %zu points from %s in %.0f ms.\n", xyz.size(), o.input.c_str(),
-             load_ms);
+  print_info(
+      "Loaded %zu points from %s in %.0f ms.\n", xyz.size(), o.input.c_str(), load_ms);
 
   // Subtract a common offset in double precision before the library's float points:
   // georeferenced coordinates keep their precision. The output keeps the input's own
@@ -237,7 +255,8 @@ main(int argc, char** argv)
       hi = hi.cwiseMax(p);
       ++finite;
     }
-  const Eigen::Vector3d offset = finite ? Eigen::Vector3d(0.5 * (lo + hi)) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d offset =
+      finite ? Eigen::Vector3d(0.5 * (lo + hi)) : Eigen::Vector3d::Zero();
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->resize(xyz.size());
   for (std::size_t i = 0; i < xyz.size(); ++i) {
@@ -251,6 +270,7 @@ main(int argc, char** argv)
   pcl::CoConeBoundary<pcl::PointXYZ> cocone;
   cocone.setInputCloud(cloud);
   cocone.setRatio(o.ratio);
+  cocone.setSpacingFactor(o.spacing_factor);
   cocone.setNormalAngle(o.normal_angle);
   cocone.setCoconeAngle(o.cocone_angle);
   cocone.setBoundaryDetection(o.boundary_detection);
@@ -262,9 +282,13 @@ main(int argc, char** argv)
     fail("no reconstruction: the cloud has fewer than 4 distinct finite points or "
          "they are collinear");
   const auto& t = cocone.getTimings();
-  print_info("Delaunay %.0f ms, Voronoi %.0f ms, boundary %.0f ms, reconstruction %.0f "
-             "ms.\n",
-             t.unique + t.delaunay, t.voronoi, t.boundary, t.reconstruction);
+  print_info("Delaunay %.0f ms, Voronoi %.0f ms, boundary %.0f ms (rho %.2f), "
+             "reconstruction %.0f ms.\n",
+             t.unique + t.delaunay,
+             t.voronoi,
+             t.boundary,
+             cocone.getUsedRatio(),
+             t.reconstruction);
 
   pcl::PointIndices boundary;
   cocone.getBoundaryPointIndices(boundary);
@@ -305,7 +329,10 @@ main(int argc, char** argv)
   border.erase(std::unique(border.begin(), border.end()), border.end());
   print_info("%zu triangles, %zu components, %zu border loops, %zu undersampled "
              "points.\n",
-             polygons.size(), components, loops.size(), boundary.indices.size());
+             polygons.size(),
+             components,
+             loops.size(),
+             boundary.indices.size());
 
   watch.reset();
   if (!cocone_app::writeMesh(o.output, mesh, error))
@@ -336,13 +363,15 @@ main(int argc, char** argv)
     written.push_back(o.normals_file);
   }
   if (!o.screenshot_file.empty() &&
-      !cocone_app::renderScreenshot(mesh, blob, boundary.indices, o.screenshot_file, error))
+      !cocone_app::renderScreenshot(
+          mesh, blob, boundary.indices, o.screenshot_file, error))
     fail(error);
   if (!o.screenshot_file.empty())
     written.push_back(o.screenshot_file);
   const double save_ms = watch.getTime();
   const double total_ms = total.getTime();
-  print_info("Wrote %s in %.0f ms; total %.0f ms.\n", o.output.c_str(), save_ms, total_ms);
+  print_info(
+      "Wrote %s in %.0f ms; total %.0f ms.\n", o.output.c_str(), save_ms, total_ms);
 
   if (!o.report_file.empty()) {
     std::ostringstream r;
@@ -350,7 +379,7 @@ main(int argc, char** argv)
     r << "{\n  \"input\": " << jsonString(o.input) << ",\n  \"points\": " << n
       << ",\n  \"finite_points\": " << finite
       << ",\n  \"unique_points\": " << cocone.getNumberOfUniquePoints()
-      << ",\n  \"parameters\": {\"ratio\": " << o.ratio
+      << ",\n  \"parameters\": {\"ratio\": " << cocone.getUsedRatio()
       << ", \"normal_angle\": " << o.normal_angle
       << ", \"cocone_angle\": " << o.cocone_angle
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")

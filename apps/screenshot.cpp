@@ -7,14 +7,15 @@
 
 #include <pcl/common/common.h>
 #include <pcl/common/io.h>
+#include <pcl/visualization/pcl_visualizer.h>
 #include <pcl/conversions.h>
 #include <pcl/point_types.h>
-#include <pcl/visualization/pcl_visualizer.h>
+
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <unistd.h>
 #include <vector>
 
 namespace cocone_app {
@@ -46,9 +47,10 @@ renderScreenshot(const pcl::PolygonMesh& mesh,
   pcl::getMinMax3D(xyz, lo, hi);
   const Eigen::Vector3f centre = 0.5f * (lo + hi).head<3>();
   const float size = (hi - lo).head<3>().norm();
-  const Eigen::Vector3f eye = centre + 2.0f * size * Eigen::Vector3f(0.5f, -0.8f, 0.9f).normalized();
-  viewer.setCameraPosition(eye.x(), eye.y(), eye.z(), centre.x(), centre.y(), centre.z(),
-                           0.0, 0.0, 1.0);
+  const Eigen::Vector3f eye =
+      centre + 2.0f * size * Eigen::Vector3f(0.5f, -0.8f, 0.9f).normalized();
+  viewer.setCameraPosition(
+      eye.x(), eye.y(), eye.z(), centre.x(), centre.y(), centre.z(), 0.0, 0.0, 1.0);
   viewer.spinOnce(1, true);
   viewer.saveScreenshot(png);
   std::ifstream f(png, std::ios::binary);
@@ -82,7 +84,8 @@ reexecUnderXvfb(int argc, char** argv)
   args.push_back(nullptr);
   ::setenv("COCONE_UNDER_XVFB", "1", 1);
   ::execvp("xvfb-run", args.data());
-  std::fprintf(stderr, "Error: -screenshot needs a display or xvfb-run (package xvfb)\n");
+  std::fprintf(stderr,
+               "Error: -screenshot needs a display or xvfb-run (package xvfb)\n");
   std::exit(1);
 }
 

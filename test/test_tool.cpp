@@ -218,6 +218,7 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
       {dir_ + "/line.xyz " + out, "collinear"},
       {in + out + " -rho abc", "not a number"},
       {in + out + " -rho -1", "-rho must be positive"},
+      {in + out + " -spacing_factor -2", "-spacing_factor"},
       {in + out + " -theta 3", "-theta"},
       {in + out + " -threads 1.5", "-threads"},
       {in + out + " -rho", "needs a value"},
