@@ -3,9 +3,9 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 
+#include <pcl/impl/instantiate.hpp>
 #include <pcl/surface/cocone_boundary.h>
 #include <pcl/surface/impl/cocone_boundary.hpp>
-#include <pcl/impl/instantiate.hpp>
 #include <pcl/point_types.h>
 
 #ifndef PCL_NO_PRECOMPILE

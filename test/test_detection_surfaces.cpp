@@ -85,22 +85,34 @@ PrintTo(const OpenCase& c, std::ostream* os)
 const OpenCase OPEN_SURFACES[] = {
     {"hemisphere",
      [](const SampleOptions& o) { return cocone_test::hemisphere(o); },
-     0.95, 0.95, 0.95},
+     0.95,
+     0.95,
+     0.95},
     {"monkey_saddle",
      [](const SampleOptions& o) { return cocone_test::monkeySaddle(o); },
-     0.95, 0.95, 0.95},
+     0.95,
+     0.95,
+     0.95},
     {"open_cylinder",
      [](const SampleOptions& o) { return cocone_test::openCylinder(o); },
-     0.95, 0.95, 0.95},
+     0.95,
+     0.95,
+     0.95},
     {"curved_sheet",
      [](const SampleOptions& o) { return cocone_test::curvedSheet(o); },
-     0.70, 0.92, 0.72},
+     0.70,
+     0.92,
+     0.72},
     {"scan_line_sheet",
      [](const SampleOptions& o) { return cocone_test::scanLineSheet(o); },
-     0.95, 0.95, 0.92},
+     0.95,
+     0.95,
+     0.92},
     {"three_components", // contains the curved sheet
      [](const SampleOptions& o) { return cocone_test::threeComponents(o); },
-     0.90, 0.94, 0.90},
+     0.90,
+     0.94,
+     0.90},
 };
 
 class OpenSurface : public ::testing::TestWithParam<OpenCase> {};
@@ -144,11 +156,12 @@ TEST_P(OpenSurface, UnevenDensity)
 
 TEST_P(OpenSurface, AutomaticModeFindsTheBoundary)
 {
-  for (const auto& o : {options(10000), options(10000, 0.05), options(10000, 0.0, 4.0)}) {
+  for (const auto& o :
+       {options(10000), options(10000, 0.05), options(10000, 0.0, 4.0)}) {
     const auto s = GetParam().make(o);
     const auto score = detect(s, AUTOMATIC);
-    EXPECT_GE(score.recall, 0.95) << s.name << " noise " << o.noise << " density 1:"
-                                  << o.density_ratio;
+    EXPECT_GE(score.recall, 0.95)
+        << s.name << " noise " << o.noise << " density 1:" << o.density_ratio;
     EXPECT_GE(score.precision, 0.90) << s.name;
   }
 }
@@ -185,5 +198,6 @@ TEST(NoisyClosedSurface, FalseBoundaryShare)
   const auto s = cocone_test::torus(options(10000, 0.15));
   const auto score = detect(s);
   EXPECT_LE(score.reported_share, 0.07);
-  RecordProperty("automatic_share", std::to_string(detect(s, AUTOMATIC).reported_share));
+  RecordProperty("automatic_share",
+                 std::to_string(detect(s, AUTOMATIC).reported_share));
 }

@@ -61,20 +61,21 @@ reconstruct(const Sample& s, Parameters parameters = Parameters(), const char* t
   run.mesh = cocone_test::scoreMesh(s, run.result);
   run.boundary = cocone_test::scoreBoundary(s, run.result.boundary_indices);
   const auto& c = run.result.counts;
-  std::printf("[ measured ] %-18s %s %s rho %.2f%s: %s; boundary %s; repair dropped %zu "
-              "(edges %zu, vertices %zu, orientation %zu) filled %zu\n",
-              s.name.c_str(),
-              tag,
-              parameters.ratio > 0.0 ? "paper" : "auto",
-              run.result.ratio,
-              parameters.boundary_detection ? "" : " (plain Co-cone)",
-              run.mesh.str().c_str(),
-              run.boundary.str().c_str(),
-              c.repair.dropped(),
-              c.repair.nonmanifold_edge,
-              c.repair.nonmanifold_vertex,
-              c.repair.orientation,
-              c.repair.filled);
+  std::printf(
+      "[ measured ] %-18s %s %s rho %.2f%s: %s; boundary %s; repair dropped %zu "
+      "(edges %zu, vertices %zu, orientation %zu) filled %zu\n",
+      s.name.c_str(),
+      tag,
+      parameters.ratio > 0.0 ? "paper" : "auto",
+      run.result.ratio,
+      parameters.boundary_detection ? "" : " (plain Co-cone)",
+      run.mesh.str().c_str(),
+      run.boundary.str().c_str(),
+      c.repair.dropped(),
+      c.repair.nonmanifold_edge,
+      c.repair.nonmanifold_vertex,
+      c.repair.orientation,
+      c.repair.filled);
   // Whatever the input, the output is an oriented 2-manifold with boundary.
   EXPECT_TRUE(run.mesh.topology.manifold()) << s.name << ": " << run.mesh.str();
   return run;
@@ -120,19 +121,29 @@ PrintTo(const ClosedCase& c, std::ostream* os)
 const OpenCase OPEN_SURFACES[] = {
     {"hemisphere",
      [](const SampleOptions& o) { return cocone_test::hemisphere(o); },
-     1, 0.95, 0.95},
+     1,
+     0.95,
+     0.95},
     {"monkey_saddle",
      [](const SampleOptions& o) { return cocone_test::monkeySaddle(o); },
-     1, 0.95, 0.95},
+     1,
+     0.95,
+     0.95},
     {"open_cylinder",
      [](const SampleOptions& o) { return cocone_test::openCylinder(o); },
-     2, 0.95, 0.95},
+     2,
+     0.95,
+     0.95},
     {"curved_sheet",
      [](const SampleOptions& o) { return cocone_test::curvedSheet(o); },
-     1, 0.70, 0.72},
+     1,
+     0.70,
+     0.72},
     {"scan_line_sheet",
      [](const SampleOptions& o) { return cocone_test::scanLineSheet(o); },
-     1, 0.95, 0.92},
+     1,
+     0.95,
+     0.92},
 };
 
 class ClosedSurface : public ::testing::TestWithParam<ClosedCase> {};
@@ -284,13 +295,16 @@ TEST(Reconstruction, NoisyClosedSurface)
 TEST(Reconstruction, Deterministic)
 {
   const auto s = cocone_test::monkeySaddle(options(5000, 0.05));
-  const Result a = pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
-  const Result b = pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const Result a =
+      pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const Result b =
+      pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
   EXPECT_EQ(a.polygons, b.polygons);
   EXPECT_EQ(a.boundary_indices, b.boundary_indices);
   // The input order does not matter: reverse the points and map back.
   std::vector<Eigen::Vector3d> reversed(s.points.rbegin(), s.points.rend());
-  const Result c = pcl::cocone::run(reversed, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const Result c =
+      pcl::cocone::run(reversed, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
   const int n = static_cast<int>(s.points.size());
   std::vector<pcl::cocone::Triangle> mapped;
   for (auto t : c.polygons) {

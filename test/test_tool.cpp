@@ -15,14 +15,14 @@
 #include <gtest/gtest.h>
 
 #include <support/surfaces.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/stat.h>
-#include <sys/wait.h>
 
 namespace {
 
@@ -159,13 +159,29 @@ TEST_F(Tool, ReportAgreesWithTheLibrary)
   std::stringstream s;
   s << f.rdbuf();
   const std::string json = s.str();
-  for (const char* key :
-       {"\"input\"", "\"points\"", "\"finite_points\"", "\"unique_points\"",
-        "\"parameters\"", "\"ratio\"", "\"normal_angle\"", "\"cocone_angle\"",
-        "\"boundary_detection\"", "\"threads\"", "\"triangles\"", "\"components\"",
-        "\"boundary_loops\"", "\"boundary_indices\"", "\"border_indices\"",
-        "\"timings_ms\"", "\"load\"", "\"delaunay\"", "\"voronoi\"", "\"boundary\"",
-        "\"reconstruction\"", "\"total\"", "\"save\""})
+  for (const char* key : {"\"input\"",
+                          "\"points\"",
+                          "\"finite_points\"",
+                          "\"unique_points\"",
+                          "\"parameters\"",
+                          "\"ratio\"",
+                          "\"normal_angle\"",
+                          "\"cocone_angle\"",
+                          "\"boundary_detection\"",
+                          "\"threads\"",
+                          "\"triangles\"",
+                          "\"components\"",
+                          "\"boundary_loops\"",
+                          "\"boundary_indices\"",
+                          "\"border_indices\"",
+                          "\"timings_ms\"",
+                          "\"load\"",
+                          "\"delaunay\"",
+                          "\"voronoi\"",
+                          "\"boundary\"",
+                          "\"reconstruction\"",
+                          "\"total\"",
+                          "\"save\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
   EXPECT_NE(json.find("\"triangles\": " + std::to_string(triangles) + ","),
             std::string::npos);
@@ -243,7 +259,8 @@ TEST_F(Tool, ScreenshotIsNotBlank)
   ASSERT_EQ(run(dir_ + "/in.pcd " + dir_ + "/s.vtk -q -screenshot " + png, &log), 0)
       << log;
   std::ifstream f(png, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::string bytes((std::istreambuf_iterator<char>(f)),
+                    std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 24u);
   EXPECT_EQ(bytes.substr(1, 3), "PNG");
   // A blank 1024 x 768 frame compresses to a few kilobytes; a rendered mesh does not.

@@ -61,7 +61,8 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
     // The circumcenter is equidistant from the four vertices.
     const double r = (dt.circumcenters[c] - dt.points[dt.cells[c][0]]).norm();
     for (int i = 1; i < 4; ++i)
-      EXPECT_NEAR((dt.circumcenters[c] - dt.points[dt.cells[c][i]]).norm(), r, 1e-9 * r);
+      EXPECT_NEAR(
+          (dt.circumcenters[c] - dt.points[dt.cells[c][i]]).norm(), r, 1e-9 * r);
     for (int i = 0; i < 4; ++i) {
       const int nb = dt.neighbors[c][i];
       if (nb < 0) {

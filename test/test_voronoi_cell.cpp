@@ -39,8 +39,12 @@ TEST(IntersectCocone, SegmentInsideTheBand)
 
 TEST(IntersectCocone, SegmentNearThePoleLineMisses)
 {
-  const CoconeHit hit = intersectCocone(
-      ORIGIN, Z, COS_COCONE, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.1, 0, 0), false);
+  const CoconeHit hit = intersectCocone(ORIGIN,
+                                        Z,
+                                        COS_COCONE,
+                                        Eigen::Vector3d(0, 0, 1),
+                                        Eigen::Vector3d(0.1, 0, 0),
+                                        false);
   EXPECT_FALSE(hit.meets);
   // The same segment below p: the co-cone is a double cone complement.
   EXPECT_FALSE(intersectCocone(ORIGIN,
@@ -69,8 +73,12 @@ TEST(IntersectCocone, SegmentCrossingTheBandWithBothEndsOutside)
 
 TEST(IntersectCocone, SegmentEndingInsideTheBand)
 {
-  const CoconeHit hit = intersectCocone(
-      ORIGIN, Z, COS_COCONE, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(2, 0, -1), false);
+  const CoconeHit hit = intersectCocone(ORIGIN,
+                                        Z,
+                                        COS_COCONE,
+                                        Eigen::Vector3d(0, 0, 1),
+                                        Eigen::Vector3d(2, 0, -1),
+                                        false);
   EXPECT_TRUE(hit.meets);
   EXPECT_NEAR(hit.max_distance, 2.0, 1e-12); // the end point (2, 0, 0)
 }
@@ -183,8 +191,8 @@ TEST(VoronoiCells, PolesFollowACurvedSheetNormal)
   double worst = 0.0;
   for (std::size_t i = 0; i < s.points.size(); ++i)
     if (!s.near_boundary[i])
-      worst = std::max(worst,
-                       angleDeg(vc.pole[unique.vertex_of_input[i]], s.normals[i]));
+      worst =
+          std::max(worst, angleDeg(vc.pole[unique.vertex_of_input[i]], s.normals[i]));
   EXPECT_LT(worst, 5.0);
 }
 
@@ -193,7 +201,8 @@ TEST(VoronoiCells, HullPolesOfATetrahedronPointAway)
   // A regular tetrahedron with a point at its centre: each corner's Voronoi cell is
   // unbounded, and its pole is the sum of the three hull facet normals, i.e. the
   // direction from the centre to the corner.
-  std::vector<Eigen::Vector3d> P{{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {0, 0, 0}};
+  std::vector<Eigen::Vector3d> P{
+      {1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {0, 0, 0}};
   const auto unique = makeUniquePoints(P);
   const Triangulation dt = triangulate(unique.points);
   ASSERT_EQ(dt.dimension, 3);

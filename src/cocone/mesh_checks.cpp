@@ -17,7 +17,10 @@ namespace {
 struct DisjointSets {
   std::vector<int> parent;
 
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  explicit DisjointSets(std::size_t n) : parent(n)
+  {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
 
   int
   find(int x)
@@ -51,7 +54,8 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
   for (std::size_t t = 0; t < oriented.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint64_t a = oriented[t][k], b = oriented[t][(k + 1) % 3];
-      items.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), a < b});
+      items.push_back(
+          {std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), a < b});
     }
   std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
     return a.key < b.key || (a.key == b.key && a.t < b.t);

@@ -177,8 +177,9 @@ run(const std::vector<Eigen::Vector3d>& points,
   }
   std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
   for (const auto& t : result.triangles)
-    result.polygons.push_back(
-        {result.representative[t[0]], result.representative[t[1]], result.representative[t[2]]});
+    result.polygons.push_back({result.representative[t[0]],
+                               result.representative[t[1]],
+                               result.representative[t[2]]});
   for (auto& loop : boundaryLoops(result.triangles, result.vertices)) {
     for (auto& v : loop)
       v = result.representative[v];

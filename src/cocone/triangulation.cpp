@@ -96,7 +96,8 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  const double extent = std::max((hi - lo).maxCoeff(), std::numeric_limits<double>::min());
+  const double extent =
+      std::max((hi - lo).maxCoeff(), std::numeric_limits<double>::min());
   const auto spread = [](std::uint64_t v) { // 21 bits -> every third bit
     v &= 0x1fffff;
     v = (v | v << 32) & 0x1f00000000ffffULL;
@@ -138,8 +139,8 @@ tetrahedronCircumcenter(const Eigen::Vector3d& a,
   const Eigen::Vector3d u = b - a, v = c - a, w = d - a;
   const Eigen::Vector3d vw = v.cross(w), wu = w.cross(u), uv = u.cross(v);
   const double den = 2.0 * u.dot(vw);
-  const Eigen::Vector3d num = u.squaredNorm() * vw + v.squaredNorm() * wu +
-                              w.squaredNorm() * uv;
+  const Eigen::Vector3d num =
+      u.squaredNorm() * vw + v.squaredNorm() * wu + w.squaredNorm() * uv;
   if (den != 0.0) {
     const Eigen::Vector3d cc = a + num / den;
     if (isFinite(cc))
@@ -222,7 +223,8 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
     for (std::size_t c = 0; c < out.cells.size(); ++c) {
       const auto s = sortedIds<4>(out.cells[c]);
       const auto& P = out.points;
-      out.circumcenters[c] = tetrahedronCircumcenter(P[s[0]], P[s[1]], P[s[2]], P[s[3]]);
+      out.circumcenters[c] =
+          tetrahedronCircumcenter(P[s[0]], P[s[1]], P[s[2]], P[s[3]]);
     }
   }
   else if (out.dimension == 2) {

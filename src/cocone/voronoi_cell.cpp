@@ -41,9 +41,7 @@ facetIds(const std::array<int, 4>& cell, int i)
 
 /** Outward unit normal of the hull facet f of a cell whose remaining vertex is o. */
 Eigen::Vector3d
-outwardNormal(const std::vector<Eigen::Vector3d>& P,
-              const std::array<int, 3>& f,
-              int o)
+outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f, int o)
 {
   Eigen::Vector3d n = (P[f[1]] - P[f[0]]).cross(P[f[2]] - P[f[0]]);
   if (n.dot(P[o] - P[f[0]]) > 0.0)
@@ -61,7 +59,8 @@ planarCells(const Triangulation& dt, double cocone_angle)
   VoronoiCells vc;
   // Plane normal from the first triangle, signed canonically for reproducibility.
   const auto f0 = facetIds(dt.cells.front(), 3);
-  Eigen::Vector3d normal = (P[f0[1]] - P[f0[0]]).cross(P[f0[2]] - P[f0[0]]).normalized();
+  Eigen::Vector3d normal =
+      (P[f0[1]] - P[f0[0]]).cross(P[f0[2]] - P[f0[0]]).normalized();
   for (int k = 0; k < 3; ++k)
     if (normal[k] != 0.0) {
       if (normal[k] < 0.0)
@@ -122,8 +121,8 @@ intersectCocone(const Eigen::Vector3d& p,
     if (!(t >= 0.0 && t <= t_max))
       return;
     hit.meets = true;
-    hit.max_distance = std::max(hit.max_distance, std::sqrt(std::max(
-                                                      0.0, ee + t * (2.0 * ed + t * dd))));
+    hit.max_distance = std::max(hit.max_distance,
+                                std::sqrt(std::max(0.0, ee + t * (2.0 * ed + t * dd))));
   };
   if (C <= 0.0)
     consider(0.0);
@@ -193,8 +192,7 @@ computeVoronoiCells(const Triangulation& dt, double cocone_angle)
       continue;
     for (const int v : dt.cells[c]) {
       const double d2 = (cc[c] - P[v]).squaredNorm();
-      if (d2 > far2[v] ||
-          (d2 == far2[v] && lexLess(cc[far_cell[v]], cc[c]))) {
+      if (d2 > far2[v] || (d2 == far2[v] && lexLess(cc[far_cell[v]], cc[c]))) {
         far2[v] = d2;
         far_cell[v] = static_cast<int>(c);
       }

@@ -7,9 +7,9 @@
 
 #include <pcl/surface/cocone/pipeline.h>
 #include <pcl/surface/reconstruction.h>
+#include <pcl/memory.h>
 #include <pcl/PointIndices.h>
 #include <pcl/Vertices.h>
-#include <pcl/memory.h>
 
 #include <string>
 #include <vector>

@@ -19,10 +19,10 @@ namespace cocone {
  * it from the lower to the higher vertex id.
  */
 struct EdgeIncidences {
-  std::vector<std::array<int, 2>> edges;       // end points, ascending
-  std::vector<std::size_t> first;              // CSR offsets, size edges + 1
-  std::vector<int> triangle;                   // per incidence
-  std::vector<std::uint8_t> forward;           // per incidence: traverses lower -> higher
+  std::vector<std::array<int, 2>> edges; // end points, ascending
+  std::vector<std::size_t> first;        // CSR offsets, size edges + 1
+  std::vector<int> triangle;             // per incidence
+  std::vector<std::uint8_t> forward;     // per incidence: traverses lower -> higher
 
   explicit EdgeIncidences(const std::vector<Triangle>& oriented);
 

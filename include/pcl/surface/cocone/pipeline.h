@@ -40,11 +40,11 @@ struct Parameters {
 
 /** \brief Sizes of the intermediate results of stages 4-7. */
 struct ReconstructionCounts {
-  std::size_t candidates = 0;     // stage 4
+  std::size_t candidates = 0;        // stage 4
   std::size_t umbrella_failures = 0; // stage 5
-  std::size_t pruned = 0;         // stage 6: triangles removed
-  std::size_t walk_components = 0; // stage 7: components of the pruned complex
-  std::size_t walked = 0;         // stage 7: triangles the walk kept
+  std::size_t pruned = 0;            // stage 6: triangles removed
+  std::size_t walk_components = 0;   // stage 7: components of the pruned complex
+  std::size_t walked = 0;            // stage 7: triangles the walk kept
   std::size_t walk_conflicts = 0; // stage 7: triangles reached with both orientations
   std::size_t walk_reseeds = 0;   // stage 7: walks started after one per component
   RepairCounts repair;            // changes by the manifold repair

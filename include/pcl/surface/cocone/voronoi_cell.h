@@ -43,7 +43,8 @@ struct VoronoiCells {
   /** h- = |v- - p|, v- the farthest Voronoi vertex of V_p on the other side of p
    * from v+; infinite if an unbounded edge of V_p goes that way, 0 if none does. */
   std::vector<double> height_minus;
-  /** Co-cone width w = max |py| over y in C_p; infinite if C_p is unbounded or empty. */
+  /** Co-cone width w = max |py| over y in C_p; infinite if C_p is unbounded or empty.
+   */
   std::vector<double> width;
   /** Per vertex: on the convex hull. */
   std::vector<std::uint8_t> on_hull;

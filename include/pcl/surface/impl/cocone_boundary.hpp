@@ -193,9 +193,9 @@ CoConeBoundary<PointInT>::getPointNormals(pcl::PointCloud<pcl::Normal>& normals)
       continue;
     const Eigen::Vector3d& n = result_.normals[v];
     normals[ids_[i]] = pcl::Normal(static_cast<float>(n.x()),
-                                  static_cast<float>(n.y()),
-                                  static_cast<float>(n.z()),
-                                  0.0f);
+                                   static_cast<float>(n.y()),
+                                   static_cast<float>(n.z()),
+                                   0.0f);
   }
 }
 
@@ -273,6 +273,7 @@ CoConeBoundary<PointInT>::performReconstruction(pcl::PointCloud<PointInT>& point
 
 } // namespace pcl
 
-#define PCL_INSTANTIATE_CoConeBoundary(T) template class PCL_EXPORTS pcl::CoConeBoundary<T>;
+#define PCL_INSTANTIATE_CoConeBoundary(T)                                              \
+  template class PCL_EXPORTS pcl::CoConeBoundary<T>;
 
 #endif // PCL_SURFACE_IMPL_COCONE_BOUNDARY_HPP_
