@@ -179,13 +179,11 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
   if (points.empty())
     return out;
 
-  // Recentre in double so that georeferenced coordinates keep their precision.
-  Eigen::Vector3d lo = points.front(), hi = points.front();
-  for (const auto& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  out.offset = 0.5 * (lo + hi);
+  // Recentre in double so that georeferenced coordinates keep their precision. The
+  // origin is an input point (the lexicographically smallest): differences of float
+  // coordinates are exact in double, so a translated cloud gives the very same
+  // recentred points, and the same triangulation even where it is degenerate.
+  out.offset = *std::min_element(points.begin(), points.end(), lexLess);
   out.points.reserve(points.size());
   for (const auto& p : points)
     out.points.push_back(p - out.offset);

@@ -47,7 +47,7 @@ struct Triangulation {
   int dimension = -1;
   /** Vertex positions, recentred: the original point is points[v] + offset. */
   std::vector<Eigen::Vector3d> points;
-  /** Centre of the bounding box, subtracted before triangulating (in double). */
+  /** The lexicographically smallest point, subtracted before triangulating. */
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   /** Vertex ids of each finite cell. */
   std::vector<std::array<int, 4>> cells;
