@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 
+#include <pcl/common/point_tests.h>
 #include <pcl/surface/cocone_boundary.h>
 #include <pcl/point_types.h>
 
@@ -13,6 +14,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace {
 
@@ -253,11 +255,119 @@ TYPED_TEST_SUITE(CoConeBoundaryTyped, XYZTypes);
 TYPED_TEST(CoConeBoundaryTyped, EveryInstantiatedTypeRuns)
 {
   const auto s = hemisphere(1500);
+  const auto cloud = toCloud<TypeParam>(s.points);
   pcl::CoConeBoundary<TypeParam> cocone;
-  cocone.setInputCloud(toCloud<TypeParam>(s.points));
+  cocone.setInputCloud(cloud);
   pcl::PointIndices boundary;
   ASSERT_TRUE(cocone.detectBoundary(boundary));
   const auto score = cocone_test::scoreBoundary(
       s, std::vector<int>(boundary.indices.begin(), boundary.indices.end()));
   EXPECT_GE(score.precision, 0.9) << score.str();
+
+  // Both reconstruct overloads.
+  pcl::PolygonMesh mesh;
+  cocone.reconstruct(mesh);
+  EXPECT_GT(mesh.polygons.size(), 2500u);
+  EXPECT_EQ(std::size_t(mesh.cloud.width) * mesh.cloud.height, cloud->size());
+  pcl::PointCloud<TypeParam> points;
+  std::vector<pcl::Vertices> polygons;
+  cocone.reconstruct(points, polygons);
+  EXPECT_EQ(points.size(), cloud->size());
+  ASSERT_EQ(polygons.size(), mesh.polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i)
+    EXPECT_EQ(polygons[i].vertices, mesh.polygons[i].vertices);
+}
+
+TEST(CoConeBoundary, ReconstructWithoutInputIsAnError)
+{
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  pcl::PolygonMesh mesh;
+  mesh.polygons.resize(3);
+  cocone.reconstruct(mesh); // PCL's base class would dereference the missing cloud
+  EXPECT_TRUE(mesh.polygons.empty());
+  pcl::PointCloud<pcl::PointXYZ> points;
+  std::vector<pcl::Vertices> polygons(2);
+  cocone.reconstruct(points, polygons);
+  EXPECT_TRUE(polygons.empty());
+  // Too few points: a defined empty mesh.
+  cocone.setInputCloud(toCloud<pcl::PointXYZ>({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+  cocone.reconstruct(mesh);
+  EXPECT_TRUE(mesh.polygons.empty());
+  EXPECT_EQ(mesh.cloud.width * mesh.cloud.height, 0u);
+}
+
+TEST(CoConeBoundary, MeshIndicesReferToTheInputCloud)
+{
+  // The hemisphere at odd positions behind junk, NaN points and duplicates; setIndices
+  // selects the hemisphere's points (and their duplicates and NaNs).
+  const auto s = hemisphere();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto cloud = toCloud<pcl::PointXYZ>({});
+  pcl::IndicesPtr indices(new pcl::Indices);
+  std::vector<int> position;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    cloud->push_back(pcl::PointXYZ(50.0f + float(i % 7), float(i % 3), float(i % 5)));
+    position.push_back(static_cast<int>(cloud->size()));
+    indices->push_back(static_cast<int>(cloud->size()));
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(s.points[i].x()),
+                                   static_cast<float>(s.points[i].y()),
+                                   static_cast<float>(s.points[i].z())));
+    if (i % 10 == 0) { // a NaN point and a duplicate, both selected
+      indices->push_back(static_cast<int>(cloud->size()));
+      cloud->push_back(pcl::PointXYZ(nan, nan, nan));
+      indices->push_back(static_cast<int>(cloud->size()));
+      cloud->push_back(cloud->at(position.back()));
+    }
+  }
+  cloud->is_dense = false;
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  cocone.setIndices(indices);
+  pcl::PolygonMesh mesh;
+  cocone.reconstruct(mesh);
+  ASSERT_GT(mesh.polygons.size(), 5000u);
+  std::vector<bool> selected(cloud->size(), false);
+  for (const int i : *indices)
+    selected[i] = true;
+  std::vector<bool> used(cloud->size(), false);
+  for (const auto& p : mesh.polygons)
+    for (const auto v : p.vertices) {
+      ASSERT_LT(std::size_t(v), cloud->size());
+      EXPECT_TRUE(selected[v]);
+      EXPECT_TRUE(pcl::isFinite((*cloud)[v]));
+      used[v] = true;
+    }
+  // Duplicates are represented by their first occurrence.
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    EXPECT_TRUE(used[position[i]]) << i;
+
+  // Border loops: closed chains of border edges of the mesh.
+  std::vector<pcl::Vertices> loops;
+  cocone.getBoundaryLoops(loops);
+  ASSERT_EQ(loops.size(), 1u);
+  std::map<std::pair<int, int>, int> edge_count;
+  for (const auto& p : mesh.polygons)
+    for (int k = 0; k < 3; ++k) {
+      const int a = p.vertices[k], b = p.vertices[(k + 1) % 3];
+      ++edge_count[{std::min(a, b), std::max(a, b)}];
+    }
+  const auto& loop = loops.front().vertices;
+  ASSERT_GT(loop.size(), 50u);
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const int a = loop[k], b = loop[(k + 1) % loop.size()];
+    EXPECT_EQ((edge_count[{std::min(a, b), std::max(a, b)}]), 1) << a << "-" << b;
+  }
+
+  // Normals: one per cloud point, NaN off the mesh, outward on the hemisphere.
+  pcl::PointCloud<pcl::Normal> normals;
+  cocone.getPointNormals(normals);
+  ASSERT_EQ(normals.size(), cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const bool in_mesh = selected[i] && pcl::isFinite((*cloud)[i]);
+    EXPECT_EQ(std::isfinite(normals[i].normal_x), in_mesh) << i;
+    const float outward =
+        in_mesh ? normals[i].getNormalVector3fMap().dot((*cloud)[i].getVector3fMap())
+                : 1.0f;
+    EXPECT_GT(outward, 0.9f) << i;
+  }
 }

@@ -283,6 +283,27 @@ TEST(Reconstruction, SphereWithHoles)
   EXPECT_LT(automatic.mesh.max_distance, 1.0);
 }
 
+TEST(Reconstruction, CandidateRules)
+{
+  // The notes' two readings of CANDIDATETRIANGLEEXTRACTION, on surfaces with borders
+  // and holes (paper's test, rho 2.5 so that the holes' rims are boundary).
+  for (const auto& s : {cocone_test::sphereWithHoles(options(10000), 3, 0.5),
+                        cocone_test::hemisphere(options(10000)),
+                        cocone_test::monkeySaddle(options(10000))}) {
+    Parameters literal = paper(2.5);
+    literal.candidate_rule = pcl::cocone::CandidateRule::LITERAL;
+    const Outcome a = reconstruct(s, paper(2.5), "interior chooses");
+    const Outcome b = reconstruct(s, literal, "literal");
+    // The literal rule keeps Delaunay triangles of three boundary vertices: across
+    // holes, through the volume; the repair has to drop them and some stay.
+    EXPECT_LT(a.mesh.max_distance, 1.0) << s.name;
+    EXPECT_LE(a.result.counts.repair.dropped(), b.result.counts.repair.dropped())
+        << s.name;
+    EXPECT_LE(a.mesh.max_distance, b.mesh.max_distance) << s.name;
+    EXPECT_EQ(a.mesh.loops, std::size_t(s.boundary_loops)) << s.name;
+  }
+}
+
 TEST(Reconstruction, NoisyClosedSurface)
 {
   // Noise of 15 % of the spacing: a few spurious holes after the repair.

@@ -91,24 +91,28 @@ reconstruct(const Triangulation& dt,
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
 
-  // Normals: the pole line, turned to the side the mesh faces.
+  // Normals: the pole line, turned to the side the mesh faces. At an undersampled
+  // point the pole says little (at a border it leans towards the convex hull): there
+  // the area-weighted normal of the point's triangles stands in.
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<Eigen::Vector3d> facing(dt.points.size(), Eigen::Vector3d::Zero());
-  std::vector<std::uint8_t> used(dt.points.size(), 0);
   for (const auto& t : result.triangles) {
     const auto& P = dt.points;
     const Eigen::Vector3d n = (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]);
-    for (const int v : t) {
+    for (const int v : t)
       facing[v] += n;
-      used[v] = 1;
-    }
   }
   result.normals.assign(dt.points.size(), Eigen::Vector3d::Constant(nan));
-  for (std::size_t v = 0; v < dt.points.size(); ++v)
-    if (used[v]) {
+  for (std::size_t v = 0; v < dt.points.size(); ++v) {
+    if (facing[v].squaredNorm() == 0.0)
+      continue; // not in the mesh
+    if (boundary[v])
+      result.normals[v] = facing[v].normalized();
+    else {
       const Eigen::Vector3d& pole = cells.pole[v];
       result.normals[v] = pole.dot(facing[v]) < 0.0 ? Eigen::Vector3d(-pole) : pole;
     }
+  }
 }
 
 } // namespace

@@ -219,7 +219,9 @@ public:
 
   /** \brief Oriented normals from the last reconstruction: the pole direction of
    * every point, turned to the side its mesh faces. A normal estimate with no
-   * neighbourhood parameter.
+   * neighbourhood parameter. At undersampled points, where the pole is unreliable
+   * (at a border it leans towards the convex hull), the area-weighted normal of the
+   * point's triangles is given instead.
    * \param[out] normals one per input point; NaN for points not in the mesh
    */
   void

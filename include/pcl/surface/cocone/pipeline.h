@@ -91,8 +91,9 @@ struct Result {
   std::vector<Triangle> polygons;
   /** Borders of the mesh as closed loops of caller ids. */
   std::vector<std::vector<int>> border_loops;
-  /** Per vertex: unit pole direction turned to agree with the mesh; NaN when the
-   * vertex is not in the mesh. */
+  /** Per vertex: unit pole direction turned to agree with the mesh (at undersampled
+   * vertices the area-weighted normal of their triangles); NaN when the vertex is not
+   * in the mesh. */
   std::vector<Eigen::Vector3d> normals;
   ReconstructionCounts counts;
   Timings timings;
