@@ -221,6 +221,8 @@ TEST_P(OpenSurface, PlainCoconeCoversTheBorders)
   const Outcome with = reconstruct(s, paper());
   // Boundary detection never makes it worse, and somewhere makes a difference.
   EXPECT_LE(with.mesh.max_distance, without.mesh.max_distance + 1e-9);
+  // Without boundary points pruning must still not erode the surface.
+  EXPECT_GE(without.mesh.used_share, 0.99);
   RecordProperty("plain_max_distance", std::to_string(without.mesh.max_distance));
 }
 

@@ -55,7 +55,9 @@ reconstruct(const Triangulation& dt,
   counts.candidates = candidates.size();
   const TriangleComplex complex(dt.points, candidates);
 
-  result.umbrella_failed = umbrellaFailures(complex, result.boundary);
+  std::vector<std::uint8_t> umbrella_triangles;
+  result.umbrella_failed =
+      umbrellaFailures(complex, result.boundary, &umbrella_triangles);
   std::vector<std::uint8_t> boundary = result.boundary;
   for (std::size_t v = 0; v < boundary.size(); ++v)
     if (result.umbrella_failed[v]) {
@@ -63,7 +65,8 @@ reconstruct(const Triangulation& dt,
       ++counts.umbrella_failures;
     }
 
-  const std::vector<std::uint8_t> present = prune(complex, boundary, &counts.pruned);
+  const std::vector<std::uint8_t> present =
+      prune(complex, boundary, &counts.pruned, umbrella_triangles);
   WalkResult walked = walk(complex, present, boundary);
   counts.walk_components = walked.components;
   counts.walked = walked.triangles.size();

@@ -11,14 +11,16 @@ namespace cocone {
 std::vector<std::uint8_t>
 prune(const TriangleComplex& complex,
       const std::vector<std::uint8_t>& boundary,
-      std::size_t* removed)
+      std::size_t* removed,
+      const std::vector<std::uint8_t>& keep)
 {
   const std::size_t m = complex.numTriangles();
   std::vector<std::uint8_t> alive(m, 1);
   const auto is_alive = [&](int t) { return alive[t] != 0; };
   const auto is_protected = [&](int t) {
     const auto& v = complex.triangle(t);
-    return boundary[v[0]] || boundary[v[1]] || boundary[v[2]];
+    return boundary[v[0]] || boundary[v[1]] || boundary[v[2]] ||
+           (!keep.empty() && keep[t]);
   };
   std::size_t count = 0;
   std::vector<int> pending;

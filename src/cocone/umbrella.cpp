@@ -11,7 +11,7 @@ namespace pcl {
 namespace cocone {
 
 bool
-hasUmbrella(const TriangleComplex& complex, int p)
+hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* kept)
 {
   const std::size_t first = complex.vertexBegin(p), last = complex.vertexEnd(p);
   if (first == last)
@@ -59,17 +59,31 @@ hasUmbrella(const TriangleComplex& complex, int p)
       }
     }
   }
+  if (kept)
+    for (std::size_t i = 0; i < star.size(); ++i)
+      if (!removed[i])
+        ++(*kept)[star[i]];
   return true;
 }
 
 std::vector<std::uint8_t>
 umbrellaFailures(const TriangleComplex& complex,
-                 const std::vector<std::uint8_t>& boundary)
+                 const std::vector<std::uint8_t>& boundary,
+                 std::vector<std::uint8_t>* umbrella_triangles)
 {
   std::vector<std::uint8_t> failed(boundary.size(), 0);
+  std::vector<std::uint8_t> kept;
+  if (umbrella_triangles)
+    kept.assign(complex.numTriangles(), 0);
   for (std::size_t p = 0; p < boundary.size(); ++p)
     if (!boundary[p])
-      failed[p] = !hasUmbrella(complex, static_cast<int>(p));
+      failed[p] = !hasUmbrella(
+          complex, static_cast<int>(p), umbrella_triangles ? &kept : nullptr);
+  if (umbrella_triangles) {
+    umbrella_triangles->assign(complex.numTriangles(), 0);
+    for (std::size_t t = 0; t < kept.size(); ++t)
+      (*umbrella_triangles)[t] = kept[t] == 3;
+  }
   return failed;
 }
 

@@ -17,19 +17,26 @@ namespace cocone {
  *
  * Deletes, virtually, the sharp edges at p and their triangles in a cascade
  * restricted to the star of p; p has an umbrella if a triangle survives.
+ * \param[in,out] kept if given and p has an umbrella, the count of each surviving
+ *                triangle is incremented
  */
 bool
-hasUmbrella(const TriangleComplex& complex, int p);
+hasUmbrella(const TriangleComplex& complex,
+            int p,
+            std::vector<std::uint8_t>* kept = nullptr);
 
 /** \brief Stage 5: the vertices outside B that have no non-sharp umbrella.
  *
  * \param[in] complex the candidate triangles
  * \param[in] boundary per vertex: in B (these are not checked)
+ * \param[out] umbrella_triangles if given, per triangle: it survives in the umbrella
+ *             of each of its three vertices (all three checked and passed)
  * \return per vertex: failed the umbrella check
  */
 std::vector<std::uint8_t>
 umbrellaFailures(const TriangleComplex& complex,
-                 const std::vector<std::uint8_t>& boundary);
+                 const std::vector<std::uint8_t>& boundary,
+                 std::vector<std::uint8_t>* umbrella_triangles = nullptr);
 
 } // namespace cocone
 } // namespace pcl
