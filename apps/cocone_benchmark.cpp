@@ -6,7 +6,7 @@
  * Delaunay triangulation alone (the floor: no Delaunay-based method can be faster), on
  * seeded area-uniform random samples of a torus and of the monkey saddle.
  *
- *   cocone_benchmark delaunay|pipeline|detect torus|saddle N [seed]
+ *   cocone_benchmark delaunay|pipeline|detect torus|saddle N [threads]
  *
  * Each run measures one thing in its own process, so that the peak resident memory
  * it prints belongs to that thing; scripts/benchmark.sh runs the grid.
@@ -79,8 +79,8 @@ main(int argc, char** argv)
   }
   const std::string what = argv[1], surface = argv[2];
   const std::size_t n = std::strtoul(argv[3], nullptr, 10);
-  const unsigned seed = argc > 4 ? std::atoi(argv[4]) : 1;
-  const auto points = sample(surface, n, seed);
+  const unsigned threads = argc > 4 ? std::atoi(argv[4]) : 1;
+  const auto points = sample(surface, n, 1);
   const double base_mb = peakMegabytes();
   const auto start = std::chrono::steady_clock::now();
   const auto seconds = [&]() {
@@ -108,18 +108,21 @@ main(int argc, char** argv)
 
   const auto stages = what == "detect" ? pcl::cocone::Stages::BOUNDARY_DETECTION
                                        : pcl::cocone::Stages::RECONSTRUCTION;
-  const pcl::cocone::Result r =
-      pcl::cocone::run(points, pcl::cocone::Parameters(), stages);
+  pcl::cocone::Parameters parameters;
+  parameters.threads = threads;
+  const pcl::cocone::Result r = pcl::cocone::run(points, parameters, stages);
   const double total = seconds();
   const auto& t = r.timings;
   const auto topology = pcl::cocone::analyzeMesh(r.triangles, r.vertices);
   std::printf(
-      "%s %zu %s: %.2f s (unique %.2f, delaunay %.2f, voronoi %.2f, boundary "
+      "%s %zu %s (%u threads): %.2f s (unique %.2f, delaunay %.2f, voronoi %.2f, "
+      "boundary "
       "%.2f, reconstruction %.2f), peak %.0f MB; rho %.2f, %zu boundary points, "
       "%zu triangles, %zu border loops, euler %ld, manifold %d\n",
       surface.c_str(),
       n,
       what.c_str(),
+      threads,
       total,
       t.unique / 1e3,
       t.delaunay / 1e3,

@@ -324,6 +324,15 @@ TEST(Reconstruction, Deterministic)
       pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
   EXPECT_EQ(a.polygons, b.polygons);
   EXPECT_EQ(a.boundary_indices, b.boundary_indices);
+  // Whatever the number of threads.
+  for (const unsigned threads : {0u, 2u, 3u}) {
+    Parameters parallel;
+    parallel.threads = threads;
+    const Result p =
+        pcl::cocone::run(s.points, parallel, pcl::cocone::Stages::RECONSTRUCTION);
+    EXPECT_EQ(p.polygons, a.polygons) << threads << " threads";
+    EXPECT_EQ(p.boundary_indices, a.boundary_indices) << threads << " threads";
+  }
   // The input order does not matter: reverse the points and map back.
   std::vector<Eigen::Vector3d> reversed(s.points.rbegin(), s.points.rend());
   const Result c =

@@ -149,7 +149,8 @@ run(const std::vector<Eigen::Vector3d>& points,
   }
   result.offset = dt.offset;
 
-  const VoronoiCells cells = computeVoronoiCells(dt, parameters.cocone_angle);
+  const VoronoiCells cells =
+      computeVoronoiCells(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
 
   result.boundary.assign(result.vertices, 0);

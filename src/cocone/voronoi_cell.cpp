@@ -5,8 +5,11 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace pcl {
 namespace cocone {
@@ -96,7 +99,55 @@ planarCells(const Triangulation& dt, double cocone_angle)
   return vc;
 }
 
+/** Bits of a non-negative double: they order as the values do (+inf included). */
+std::uint64_t
+bitsOf(double x)
+{
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof(b));
+  return b;
+}
+
+double
+doubleOf(std::uint64_t b)
+{
+  double x;
+  std::memcpy(&x, &b, sizeof(x));
+  return x;
+}
+
+/** Raise *target to x (x >= 0) atomically. */
+void
+atomicMax(std::uint64_t* target, double x)
+{
+  const std::uint64_t bits = bitsOf(x);
+  std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+  while (bits > seen &&
+         !__atomic_compare_exchange_n(
+             target, &seen, bits, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+}
+
+/** Replace *target by x atomically if *target is -1 or less(*target, x). */
+template <typename Less>
+void
+atomicRaise(int* target, int x, const Less& less)
+{
+  int seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+  while ((seen < 0 || less(seen, x)) &&
+         !__atomic_compare_exchange_n(
+             target, &seen, x, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+}
+
 } // namespace
+
+int
+resolveThreads(unsigned int requested)
+{
+  const int available = std::max(1, omp_get_num_procs());
+  return requested == 0 ? available : static_cast<int>(requested);
+}
 
 CoconeHit
 intersectCocone(const Eigen::Vector3d& p,
@@ -149,7 +200,9 @@ intersectCocone(const Eigen::Vector3d& p,
 }
 
 VoronoiCells
-computeVoronoiCells(const Triangulation& dt, double cocone_angle)
+computeVoronoiCells(const Triangulation& dt,
+                    double cocone_angle,
+                    unsigned int num_threads)
 {
   if (dt.dimension == 2 && !dt.cells.empty())
     return planarCells(dt, cocone_angle);
@@ -184,45 +237,57 @@ computeVoronoiCells(const Triangulation& dt, double cocone_angle)
       vc.on_hull[v] = 1;
     }
 
+  // The per-vertex maxima below are taken with atomic updates, so the cells can be
+  // visited in parallel: a maximum does not depend on the order of the updates.
+  const int threads = resolveThreads(num_threads);
+
   // Positive pole: the farthest Voronoi vertex (ties broken by position).
-  std::vector<double> far2(n, -1.0);
+  std::vector<std::uint64_t> far2(n, 0); // bits of non-negative doubles
   std::vector<int> far_cell(n, -1);
-  for (std::size_t c = 0; c < m; ++c) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
     if (!isFinite(cc[c]))
       continue;
-    for (const int v : dt.cells[c]) {
-      const double d2 = (cc[c] - P[v]).squaredNorm();
-      if (d2 > far2[v] || (d2 == far2[v] && lexLess(cc[far_cell[v]], cc[c]))) {
-        far2[v] = d2;
-        far_cell[v] = static_cast<int>(c);
-      }
-    }
+    for (const int v : dt.cells[c])
+      atomicMax(&far2[v], (cc[c] - P[v]).squaredNorm());
+  }
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
+    if (!isFinite(cc[c]))
+      continue;
+    for (const int v : dt.cells[c])
+      if (bitsOf((cc[c] - P[v]).squaredNorm()) == far2[v])
+        atomicRaise(&far_cell[v], static_cast<int>(c), [&](int a, int b) {
+          return lexLess(cc[a], cc[b]) || (cc[a] == cc[b] && a < b);
+        });
   }
   vc.pole.assign(n, Eigen::Vector3d::Zero());
   vc.height_plus.assign(n, INF);
   for (std::size_t v = 0; v < n; ++v) {
+    const double d2 = doubleOf(far2[v]);
     if (vc.on_hull[v] && hull_sum[v].norm() > 0.0)
       vc.pole[v] = hull_sum[v].normalized();
-    else if (far_cell[v] >= 0 && far2[v] > 0.0) {
-      vc.height_plus[v] = std::sqrt(far2[v]);
+    else if (far_cell[v] >= 0 && d2 > 0.0) {
+      vc.height_plus[v] = std::sqrt(d2);
       vc.pole[v] = (cc[far_cell[v]] - P[v]) / vc.height_plus[v];
     }
   }
 
   // Negative pole: the farthest Voronoi vertex on the other side of p.
-  std::vector<double> neg2(n, 0.0);
-  for (std::size_t c = 0; c < m; ++c) {
+  std::vector<std::uint64_t> neg2(n, 0);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
     if (!isFinite(cc[c]))
       continue;
     for (const int v : dt.cells[c]) {
       const Eigen::Vector3d y = cc[c] - P[v];
       if (y.dot(vc.pole[v]) < 0.0)
-        neg2[v] = std::max(neg2[v], y.squaredNorm());
+        atomicMax(&neg2[v], y.squaredNorm());
     }
   }
   vc.height_minus.resize(n);
   for (std::size_t v = 0; v < n; ++v)
-    vc.height_minus[v] = std::sqrt(neg2[v]);
+    vc.height_minus[v] = std::sqrt(doubleOf(neg2[v]));
   // An unbounded Voronoi edge going to the negative side puts v- at infinity.
   for (const auto& h : hull)
     for (const int v : h.f)
@@ -230,41 +295,62 @@ computeVoronoiCells(const Triangulation& dt, double cocone_angle)
         vc.height_minus[v] = INF;
 
   // Width and the co-cone triangles: one pass over the Voronoi edges, i.e. over the
-  // Delaunay triangles, each visited from its lower-numbered cell.
+  // Delaunay triangles, each visited from its lower-numbered cell. Each thread
+  // collects its triangles; the sort below fixes their order.
   const double cos_angle = std::cos(cocone_angle);
-  vc.width.assign(n, -INF);
-  for (std::size_t c = 0; c < m; ++c) {
-    for (int i = 0; i < 4; ++i) {
-      const int other = dt.neighbors[c][i];
-      if (other >= 0 && other < static_cast<int>(c))
-        continue;
-      const auto f = facetIds(dt.cells[c], i);
-      Eigen::Vector3d a = cc[c], d;
-      const bool ray = other < 0;
-      if (ray)
-        d = outwardNormal(P, f, dt.cells[c][i]);
-      else {
-        // Orient the segment canonically so the test is bitwise reproducible.
-        Eigen::Vector3d b = cc[other];
-        if (lexLess(b, a))
-          std::swap(a, b);
-        d = b - a;
-      }
-      if (!isFinite(a) || !isFinite(d))
-        continue;
-      std::uint8_t meets = 0;
-      for (int k = 0; k < 3; ++k) {
-        const int v = f[k];
-        const CoconeHit hit = intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
-        if (hit.meets) {
-          meets |= static_cast<std::uint8_t>(1u << k);
-          vc.width[v] = std::max(vc.width[v], hit.max_distance);
+  std::vector<std::uint64_t> width(n, 0);
+  std::vector<std::uint8_t> met(n, 0);
+  std::vector<std::vector<CoconeTriangle>> found(threads);
+#pragma omp parallel num_threads(threads)
+  {
+    auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
+      for (int i = 0; i < 4; ++i) {
+        const int other = dt.neighbors[c][i];
+        if (other >= 0 && other < c)
+          continue;
+        const auto f = facetIds(dt.cells[c], i);
+        Eigen::Vector3d a = cc[c], d;
+        const bool ray = other < 0;
+        if (ray)
+          d = outwardNormal(P, f, dt.cells[c][i]);
+        else {
+          // Orient the segment canonically so the test is bitwise reproducible.
+          Eigen::Vector3d b = cc[other];
+          if (lexLess(b, a))
+            std::swap(a, b);
+          d = b - a;
         }
+        if (!isFinite(a) || !isFinite(d))
+          continue;
+        std::uint8_t meets = 0;
+        for (int k = 0; k < 3; ++k) {
+          const int v = f[k];
+          const CoconeHit hit = intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
+          if (hit.meets) {
+            meets |= static_cast<std::uint8_t>(1u << k);
+            atomicMax(&width[v], hit.max_distance);
+            if (!met[v])
+              __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
+          }
+        }
+        if (meets)
+          mine.push_back({f, meets});
       }
-      if (meets)
-        vc.triangles.push_back({f, meets});
     }
   }
+  std::size_t total = 0;
+  for (const auto& t : found)
+    total += t.size();
+  vc.triangles.reserve(total);
+  for (auto& t : found) {
+    vc.triangles.insert(vc.triangles.end(), t.begin(), t.end());
+    std::vector<CoconeTriangle>().swap(t);
+  }
+  vc.width.resize(n);
+  for (std::size_t v = 0; v < n; ++v)
+    vc.width[v] = met[v] ? doubleOf(width[v]) : -INF;
   // A co-cone that meets no Voronoi edge tells nothing about flatness: not flat.
   for (auto& w : vc.width)
     if (w < 0.0)

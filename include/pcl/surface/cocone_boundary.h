@@ -167,21 +167,21 @@ public:
 
   /** \brief Set the number of threads (PCL convention: 0 = all processors).
    *
-   * The output does not depend on it. The stages currently run on one thread; the
-   * setting is kept for the parallel stages.
+   * The output does not depend on it. The Voronoi stage runs in parallel; the others
+   * on one thread.
    * \param[in] nr_threads number of threads, 0 for all (default 1)
    */
   void
   setNumberOfThreads(unsigned int nr_threads = 0)
   {
-    threads_ = nr_threads;
+    parameters_.threads = nr_threads;
   }
 
   /** \brief The number of threads set (0 = all processors). */
   unsigned int
   getNumberOfThreads() const
   {
-    return threads_;
+    return parameters_.threads;
   }
 
   /** \brief Number of distinct finite points (Delaunay vertices) of the last run. */
@@ -287,7 +287,6 @@ private:
   fillPolygons(std::vector<pcl::Vertices>& polygons) const;
 
   cocone::Parameters parameters_;
-  unsigned int threads_ = 1;
   cocone::Timings timings_;
   /** The last run: its core result and the cloud size it was indexed against. */
   cocone::Result result_;

@@ -36,6 +36,9 @@ struct Parameters {
   CandidateRule candidate_rule = CandidateRule::INTERIOR_CHOOSES;
   /** Close border loops of three edges that are one missing Delaunay triangle. */
   bool fill_triangle_holes = true;
+  /** Threads for the parallel stages, 0 for all processors; the output does not
+   * depend on it. */
+  unsigned int threads = 1;
 };
 
 /** \brief Sizes of the intermediate results of stages 4-7. */

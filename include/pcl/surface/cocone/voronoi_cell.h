@@ -92,11 +92,20 @@ intersectCocone(const Eigen::Vector3d& p,
 
 /** \brief Compute poles, heights, widths and the co-cone triangles (stage 2).
  *
+ * The result does not depend on the number of threads.
  * \param[in] dt the triangulation (dimension 2 or 3)
  * \param[in] cocone_angle the co-cone angle in radians (3 pi / 8 in the paper)
+ * \param[in] num_threads threads to use, 0 for all processors
  */
 VoronoiCells
-computeVoronoiCells(const Triangulation& dt, double cocone_angle);
+computeVoronoiCells(const Triangulation& dt,
+                    double cocone_angle,
+                    unsigned int num_threads = 1);
+
+/** \brief A thread count: \a requested, or all processors for 0 (PCL's
+ * convention). */
+int
+resolveThreads(unsigned int requested);
 
 } // namespace cocone
 } // namespace pcl
