@@ -55,6 +55,25 @@ temporaryName(const std::string& path)
   return dir + ".partial-" + std::to_string(::getpid()) + "-" + name;
 }
 
+/** Write through a temporary file renamed into place: a failure leaves no partial
+ * file. PCL's writers print their own complaints; the tool prints one line instead. */
+template <typename Write>
+bool
+writeAtomically(const std::string& path, const Write& write, std::string& error)
+{
+  const std::string tmp = temporaryName(path);
+  const auto verbosity = pcl::console::getVerbosityLevel();
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  const bool written = write(tmp);
+  pcl::console::setVerbosityLevel(verbosity);
+  if (!written || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    error = "cannot write '" + path + "'";
+    return false;
+  }
+  return true;
+}
+
 /** Read whitespace-separated x y z lines; '#' starts a comment. */
 bool
 readText(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error)
@@ -306,25 +325,18 @@ writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& er
     error = "unknown output format '" + ext + "' (use .vtk, .ply, .obj or .stl)";
     return false;
   }
-  const std::string tmp = temporaryName(path);
-  int status = -1;
-  const auto verbosity = pcl::console::getVerbosityLevel();
-  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-  if (ext == "vtk")
-    status = pcl::io::saveVTKFile(tmp, mesh, 10);
-  else if (ext == "ply")
-    status = pcl::io::savePLYFileBinary(tmp, mesh);
-  else if (ext == "obj")
-    status = pcl::io::saveOBJFile(tmp, mesh, 10);
-  else if (ext == "stl")
-    status = pcl::io::savePolygonFileSTL(tmp, mesh, true) ? 0 : -1;
-  pcl::console::setVerbosityLevel(verbosity);
-  if (status < 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    error = "cannot write '" + path + "'";
-    return false;
-  }
-  return true;
+  return writeAtomically(
+      path,
+      [&](const std::string& tmp) {
+        if (ext == "vtk")
+          return pcl::io::saveVTKFile(tmp, mesh, 10) >= 0;
+        if (ext == "ply")
+          return pcl::io::savePLYFileBinary(tmp, mesh) >= 0;
+        if (ext == "obj")
+          return pcl::io::saveOBJFile(tmp, mesh, 10) >= 0;
+        return pcl::io::savePolygonFileSTL(tmp, mesh, true);
+      },
+      error);
 }
 
 bool
@@ -336,18 +348,29 @@ writeCloud(const std::string& path,
     error = "'" + path + "' must be a .pcd file";
     return false;
   }
-  const std::string tmp = temporaryName(path);
-  const auto verbosity = pcl::console::getVerbosityLevel();
-  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-  const int status = pcl::io::savePCDFile(
-      tmp, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true);
-  pcl::console::setVerbosityLevel(verbosity);
-  if (status < 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    error = "cannot write '" + path + "'";
-    return false;
-  }
-  return true;
+  return writeAtomically(
+      path,
+      [&](const std::string& tmp) {
+        return pcl::io::savePCDFile(tmp,
+                                    cloud,
+                                    Eigen::Vector4f::Zero(),
+                                    Eigen::Quaternionf::Identity(),
+                                    true) >= 0;
+      },
+      error);
+}
+
+bool
+writeText(const std::string& path, const std::string& text, std::string& error)
+{
+  return writeAtomically(
+      path,
+      [&](const std::string& tmp) {
+        std::ofstream f(tmp);
+        f << text;
+        return static_cast<bool>(f);
+      },
+      error);
 }
 
 } // namespace cocone_app

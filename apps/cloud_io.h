@@ -72,4 +72,8 @@ writeCloud(const std::string& path,
            const pcl::PCLPointCloud2& cloud,
            std::string& error);
 
+/** Write a text file the same way. */
+bool
+writeText(const std::string& path, const std::string& text, std::string& error);
+
 } // namespace cocone_app

@@ -392,17 +392,8 @@ main(int argc, char** argv)
       << ", \"voronoi\": " << t.voronoi << ", \"boundary\": " << t.boundary
       << ", \"reconstruction\": " << t.reconstruction << ", \"total\": " << total_ms
       << ", \"save\": " << save_ms << "}\n}\n";
-    const std::string tmp = o.report_file + ".partial";
-    {
-      std::ofstream f(tmp);
-      f << r.str();
-      if (!f)
-        fail("cannot write '" + o.report_file + "'");
-    }
-    if (std::rename(tmp.c_str(), o.report_file.c_str()) != 0) {
-      std::remove(tmp.c_str());
-      fail("cannot write '" + o.report_file + "'");
-    }
+    if (!cocone_app::writeText(o.report_file, r.str(), error))
+      fail(error);
   }
   return 0;
 }

@@ -10,11 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include <support/cases.h>
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
 #include <cstdio>
 
+using cocone_test::options;
 using cocone_test::Sample;
 using cocone_test::SampleOptions;
 
@@ -45,16 +47,6 @@ reconstruct(const Sample& s, const char* tag)
   return o;
 }
 
-SampleOptions
-options(double noise = 0.0, double density_ratio = 1.0, std::size_t n = 10000)
-{
-  SampleOptions o;
-  o.n = n;
-  o.noise = noise;
-  o.density_ratio = density_ratio;
-  return o;
-}
-
 /** Exact topology and a good border. */
 void
 expectExact(const Sample& s, const Outcome& o, double max_distance = 1.0)
@@ -73,27 +65,28 @@ TEST(AutomaticMode, HoledSpheres)
 {
   for (const double degrees : {30.0, 15.0}) {
     const double angle = degrees * M_PI / 180.0;
-    const auto clean = cocone_test::sphereWithHoles(options(), 3, angle);
+    const auto clean = cocone_test::sphereWithHoles(options(10000), 3, angle);
     expectExact(clean, reconstruct(clean, "clean"));
-    const auto uneven = cocone_test::sphereWithHoles(options(0.0, 4.0), 3, angle);
+    const auto uneven =
+        cocone_test::sphereWithHoles(options(10000, 0.0, 4.0), 3, angle);
     expectExact(uneven, reconstruct(uneven, "density 1:4"));
-    const auto noisy = cocone_test::sphereWithHoles(options(0.05), 3, angle);
+    const auto noisy = cocone_test::sphereWithHoles(options(10000, 0.05), 3, angle);
     expectExact(noisy, reconstruct(noisy, "noise 5 %"));
   }
 }
 
 TEST(AutomaticMode, NoisyHemisphereIsExact)
 {
-  const auto s = cocone_test::hemisphere(options(0.05));
+  const auto s = cocone_test::hemisphere(options(10000, 0.05));
   expectExact(s, reconstruct(s, "noise 5 %"));
 }
 
 TEST(AutomaticMode, NoisyClosedSurfaces)
 {
   // Noise of 15 % of the spacing: at most 2 spurious border loops.
-  for (const auto& s : {cocone_test::torus(options(0.15)),
-                        cocone_test::sphere(options(0.15)),
-                        cocone_test::sphereWithHoles(options(0.15), 3, 0.5)}) {
+  for (const auto& s : {cocone_test::torus(options(10000, 0.15)),
+                        cocone_test::sphere(options(10000, 0.15)),
+                        cocone_test::sphereWithHoles(options(10000, 0.15), 3, 0.5)}) {
     const Outcome o = reconstruct(s, "noise 15 %");
     EXPECT_LE(o.mesh.loops, std::size_t(s.boundary_loops) + 2) << s.name;
     EXPECT_GE(o.mesh.loops, std::size_t(s.boundary_loops)) << s.name;
@@ -105,7 +98,7 @@ TEST(AutomaticMode, AnisotropicSampling)
 {
   // Scan lines three spacings apart (1:3 along and across), evenly and unevenly.
   for (const double ratio : {1.0, 4.0}) {
-    const auto s = cocone_test::scanLineSheet(options(0.0, ratio));
+    const auto s = cocone_test::scanLineSheet(options(10000, 0.0, ratio));
     expectExact(s, reconstruct(s, ratio > 1.0 ? "density 1:4" : "clean"));
   }
 }

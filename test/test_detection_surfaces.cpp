@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <support/cases.h>
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
@@ -16,20 +17,12 @@
 #include <functional>
 #include <ostream>
 
+using cocone_test::options;
+using cocone_test::paper;
 using cocone_test::Sample;
 using cocone_test::SampleOptions;
 
 namespace {
-
-/** The paper's test with a fixed rho (no spacing test). */
-pcl::cocone::Parameters
-paper(double ratio = 1.5)
-{
-  pcl::cocone::Parameters p;
-  p.ratio = ratio;
-  p.spacing_factor = 0.0;
-  return p;
-}
 
 /** The library's default: automatic rho and the spacing test. */
 const pcl::cocone::Parameters AUTOMATIC;
@@ -47,17 +40,6 @@ detect(const Sample& s, const pcl::cocone::Parameters& parameters = paper())
               r.ratio,
               score.str().c_str());
   return score;
-}
-
-SampleOptions
-options(std::size_t n, double noise = 0.0, double density_ratio = 1.0, bool even = true)
-{
-  SampleOptions o;
-  o.n = n;
-  o.noise = noise;
-  o.density_ratio = density_ratio;
-  o.even = even;
-  return o;
 }
 
 using Generator = std::function<Sample(const SampleOptions&)>;

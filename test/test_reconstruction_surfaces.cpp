@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <support/cases.h>
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
@@ -17,6 +18,8 @@
 #include <functional>
 #include <ostream>
 
+using cocone_test::options;
+using cocone_test::paper;
 using cocone_test::Sample;
 using cocone_test::SampleOptions;
 using pcl::cocone::Parameters;
@@ -24,32 +27,11 @@ using pcl::cocone::Result;
 
 namespace {
 
-SampleOptions
-options(std::size_t n, double noise = 0.0, double density_ratio = 1.0, bool even = true)
-{
-  SampleOptions o;
-  o.n = n;
-  o.noise = noise;
-  o.density_ratio = density_ratio;
-  o.even = even;
-  return o;
-}
-
 struct Outcome {
   Result result;
   cocone_test::MeshScore mesh;
   cocone_test::BoundaryScore boundary;
 };
-
-/** The paper's test with a fixed rho (no spacing test). */
-Parameters
-paper(double ratio = 1.5)
-{
-  Parameters p;
-  p.ratio = ratio;
-  p.spacing_factor = 0.0;
-  return p;
-}
 
 Outcome
 reconstruct(const Sample& s, Parameters parameters = Parameters(), const char* tag = "")

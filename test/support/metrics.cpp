@@ -33,23 +33,29 @@ NearQuery::key(long x, long y, long z) const
          (static_cast<std::int64_t>(z) * 83492791);
 }
 
-double
-NearQuery::nearest(const Eigen::Vector3d& q, double radius) const
+template <typename Visit>
+void
+NearQuery::visit(const Eigen::Vector3d& q, double radius, const Visit& f) const
 {
   const long r = static_cast<long>(std::ceil(radius / cell_));
   const long x = std::lround(std::floor(q.x() / cell_));
   const long y = std::lround(std::floor(q.y() / cell_));
   const long z = std::lround(std::floor(q.z() / cell_));
-  double best = std::numeric_limits<double>::infinity();
   for (long i = x - r; i <= x + r; ++i)
     for (long j = y - r; j <= y + r; ++j)
       for (long k = z - r; k <= z + r; ++k) {
         const auto it = grid_.find(key(i, j, k));
-        if (it == grid_.end())
-          continue;
-        for (const int p : it->second)
-          best = std::min(best, (points_[p] - q).norm());
+        if (it != grid_.end())
+          for (const int p : it->second)
+            f(p, (points_[p] - q).norm());
       }
+}
+
+double
+NearQuery::nearest(const Eigen::Vector3d& q, double radius) const
+{
+  double best = std::numeric_limits<double>::infinity();
+  visit(q, radius, [&](int, double d) { best = std::min(best, d); });
   return best <= radius ? best : std::numeric_limits<double>::infinity();
 }
 
@@ -57,20 +63,10 @@ std::vector<int>
 NearQuery::within(const Eigen::Vector3d& q, double radius) const
 {
   std::vector<int> out;
-  const long r = static_cast<long>(std::ceil(radius / cell_));
-  const long x = std::lround(std::floor(q.x() / cell_));
-  const long y = std::lround(std::floor(q.y() / cell_));
-  const long z = std::lround(std::floor(q.z() / cell_));
-  for (long i = x - r; i <= x + r; ++i)
-    for (long j = y - r; j <= y + r; ++j)
-      for (long k = z - r; k <= z + r; ++k) {
-        const auto it = grid_.find(key(i, j, k));
-        if (it == grid_.end())
-          continue;
-        for (const int p : it->second)
-          if ((points_[p] - q).norm() <= radius)
-            out.push_back(p);
-      }
+  visit(q, radius, [&](int p, double d) {
+    if (d <= radius)
+      out.push_back(p);
+  });
   return out;
 }
 

@@ -36,6 +36,11 @@ private:
   std::int64_t
   key(long x, long y, long z) const;
 
+  /** Call f(index, distance) for the points in the grid cells within radius. */
+  template <typename Visit>
+  void
+  visit(const Eigen::Vector3d& q, double radius, const Visit& f) const;
+
   const std::vector<Eigen::Vector3d>& points_;
   double cell_;
   std::unordered_map<std::int64_t, std::vector<int>> grid_;
