@@ -5,6 +5,7 @@
 
 #include <pcl/common/point_tests.h>
 #include <pcl/surface/cocone_boundary.h>
+#include <pcl/conversions.h>
 #include <pcl/point_types.h>
 
 #include <gtest/gtest.h>
@@ -264,11 +265,24 @@ TYPED_TEST(CoConeBoundaryTyped, EveryInstantiatedTypeRuns)
       s, std::vector<int>(boundary.indices.begin(), boundary.indices.end()));
   EXPECT_GE(score.precision, 0.9) << score.str();
 
-  // Both reconstruct overloads.
+  // Both reconstruct overloads. Every field of every point survives into the mesh's
+  // cloud: give the non-xyz fields distinct values first.
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    TypeParam& p = (*cloud)[i];
+    const Eigen::Vector3f xyz = p.getVector3fMap();
+    auto* bytes = reinterpret_cast<unsigned char*>(&p);
+    for (std::size_t b = 0; b < sizeof(TypeParam); ++b)
+      bytes[b] = static_cast<unsigned char>((i * 31 + b * 7) % 251);
+    p.getVector3fMap() = xyz;
+  }
   pcl::PolygonMesh mesh;
   cocone.reconstruct(mesh);
   EXPECT_GT(mesh.polygons.size(), 2500u);
   EXPECT_EQ(std::size_t(mesh.cloud.width) * mesh.cloud.height, cloud->size());
+  pcl::PCLPointCloud2 expected;
+  pcl::toPCLPointCloud2(*cloud, expected);
+  EXPECT_EQ(mesh.cloud.fields.size(), expected.fields.size());
+  EXPECT_EQ(mesh.cloud.data, expected.data);
   pcl::PointCloud<TypeParam> points;
   std::vector<pcl::Vertices> polygons;
   cocone.reconstruct(points, polygons);

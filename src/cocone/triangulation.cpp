@@ -11,6 +11,8 @@
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
+#include "points.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -32,17 +34,8 @@ using CellBase = CGAL::Triangulation_cell_base_with_info_3<
 using Tds = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
 
-bool
-isFinite(const Eigen::Vector3d& p)
-{
-  return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
-}
-
-bool
-lexLess(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-  return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-}
+using detail::isFinite;
+using detail::lexLess;
 
 Eigen::Vector3d
 toEigen(const CGAL::Exact_predicates_exact_constructions_kernel::Point_3& p)

@@ -5,6 +5,7 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
+#include "points.h"
 #include <omp.h>
 
 #include <algorithm>
@@ -18,17 +19,8 @@ namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
 
-bool
-isFinite(const Eigen::Vector3d& p)
-{
-  return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
-}
-
-bool
-lexLess(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-  return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-}
+using detail::isFinite;
+using detail::lexLess;
 
 /** The facet of cell c opposite its vertex i, as ascending vertex ids. */
 std::array<int, 3>
