@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 namespace cocone_app {
@@ -55,6 +56,200 @@ temporaryName(const std::string& path)
   return dir + ".partial-" + std::to_string(::getpid()) + "-" + name;
 }
 
+std::size_t
+fileSize(const std::string& path)
+{
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  return f ? static_cast<std::size_t>(f.tellg()) : 0;
+}
+
+/** Parse an unsigned integer token strictly. */
+bool
+parseCount(const std::string& token, std::size_t& value)
+{
+  if (token.empty() || token.size() > 12 ||
+      token.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  value = std::stoull(token);
+  return true;
+}
+
+/** A PCD header PCL's reader can be trusted with: consistent FIELDS, SIZE, TYPE and
+ * COUNT, a known DATA kind, and no more points than the file can hold (compressed
+ * data shrinks by less than 100 times). */
+bool
+checkPcdHeader(const std::string& path, std::string& error)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> fields, sizes, types, counts;
+  std::size_t width = 0, height = 1, points = 0;
+  bool have_width = false, have_points = false;
+  std::string line, data;
+  std::set<std::string> seen;
+  for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+    if (line.size() > 65536)
+      break;
+    // A header is plain text: PCL's parser and its data offset disagree otherwise.
+    if (std::any_of(line.begin(), line.end(), [](char c) {
+          return (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r') ||
+                 static_cast<unsigned char>(c) >= 0x7f;
+        }))
+      break;
+    if (!line.empty() && line.back() == '\r')
+      line.pop_back();
+    if (line.empty() || std::isspace(static_cast<unsigned char>(line[0])))
+      break; // PCL's parser reads such a line differently
+    std::istringstream tokens(line);
+    std::string key, token;
+    tokens >> key;
+    std::vector<std::string> values;
+    while (tokens >> token)
+      values.push_back(token);
+    if (key.empty() || key[0] == '#')
+      continue;
+    // Only the keys of the format, each once: PCL's parser matches others loosely.
+    static const std::set<std::string> KEYS{"VERSION",
+                                            "FIELDS",
+                                            "COLUMNS",
+                                            "SIZE",
+                                            "TYPE",
+                                            "COUNT",
+                                            "WIDTH",
+                                            "HEIGHT",
+                                            "VIEWPOINT",
+                                            "POINTS",
+                                            "DATA"};
+    if (!KEYS.count(key) || !seen.insert(key).second)
+      break;
+    if (key == "FIELDS" || key == "COLUMNS")
+      fields = values;
+    else if (key == "SIZE")
+      sizes = values;
+    else if (key == "TYPE")
+      types = values;
+    else if (key == "COUNT")
+      counts = values;
+    else if (key == "WIDTH" &&
+             !(have_width = values.size() == 1 && parseCount(values[0], width)))
+      break;
+    else if (key == "HEIGHT" && !(values.size() == 1 && parseCount(values[0], height)))
+      break;
+    else if (key == "POINTS" &&
+             !(have_points = values.size() == 1 && parseCount(values[0], points)))
+      break;
+    else if (key == "VIEWPOINT" && values.size() != 7)
+      break;
+    else if (key == "DATA") {
+      data = values.empty() ? "" : values[0];
+      break;
+    }
+  }
+  const std::size_t data_start = in ? static_cast<std::size_t>(in.tellg()) : 0;
+  error = "not a valid .pcd file (header)";
+  if (fields.empty() || sizes.size() != fields.size() ||
+      types.size() != fields.size() ||
+      (!counts.empty() && counts.size() != fields.size()) || !have_width ||
+      (data != "ascii" && data != "binary" && data != "binary_compressed"))
+    return false;
+  std::size_t step = 0;
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    std::size_t size = 0, count = 1;
+    if (!parseCount(sizes[k], size) ||
+        (size != 1 && size != 2 && size != 4 && size != 8))
+      return false;
+    if ((types[k] != "I" && types[k] != "U" && types[k] != "F") ||
+        (types[k] == "F" && size < 4))
+      return false;
+    if (!counts.empty() &&
+        (!parseCount(counts[k], count) || count == 0 || count > 65536))
+      return false;
+    step += size * count;
+  }
+  const std::size_t n = width * height, file_size = fileSize(path);
+  if (n == 0 || step > 65536 || (have_points && points != n) ||
+      n > 100 * (file_size + 1) || data_start == 0 || data_start > file_size)
+    return false;
+  if (data == "binary" && file_size - data_start < n * step)
+    return false; // truncated
+  if (data == "binary_compressed") {
+    std::uint32_t sizes_of[2] = {0, 0}; // compressed, uncompressed
+    in.read(reinterpret_cast<char*>(sizes_of), sizeof(sizes_of));
+    if (!in || sizes_of[1] != n * step || sizes_of[0] > file_size - data_start - 8)
+      return false;
+  }
+  error.clear();
+  return true;
+}
+
+/** A PLY header PCL's reader can be trusted with: a known format, elements with
+ * counts the file can hold, properties of known types. */
+bool
+checkPlyHeader(const std::string& path, std::string& error)
+{
+  static const std::set<std::string> TYPES{"char",
+                                           "uchar",
+                                           "short",
+                                           "ushort",
+                                           "int",
+                                           "uint",
+                                           "float",
+                                           "double",
+                                           "int8",
+                                           "uint8",
+                                           "int16",
+                                           "uint16",
+                                           "int32",
+                                           "uint32",
+                                           "float32",
+                                           "float64"};
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  error = "not a valid .ply file (header)";
+  if (!std::getline(in, line) || (line != "ply" && line != "ply\r"))
+    return false;
+  const std::size_t file_size = fileSize(path);
+  std::size_t elements = 0;
+  bool format = false;
+  for (int lines = 0; lines < 4096 && std::getline(in, line); ++lines) {
+    if (!line.empty() && line.back() == '\r')
+      line.pop_back();
+    std::istringstream tokens(line);
+    std::string key;
+    tokens >> key;
+    std::vector<std::string> values;
+    for (std::string t; tokens >> t;)
+      values.push_back(t);
+    if (key == "end_header") {
+      if (!format)
+        return false;
+      error.clear();
+      return true;
+    }
+    if (key == "format")
+      format = values.size() == 2 &&
+               (values[0] == "ascii" || values[0] == "binary_little_endian" ||
+                values[0] == "binary_big_endian");
+    else if (key == "element") {
+      std::size_t count = 0;
+      if (values.size() != 2 || !parseCount(values[1], count))
+        return false;
+      elements += count;
+      if (elements > 100 * (file_size + 1))
+        return false;
+    }
+    else if (key == "property") {
+      const bool list = !values.empty() && values[0] == "list";
+      if (list
+              ? values.size() != 4 || !TYPES.count(values[1]) || !TYPES.count(values[2])
+              : values.size() != 2 || !TYPES.count(values[0]))
+        return false;
+    }
+    else if (key != "comment" && key != "obj_info")
+      return false;
+  }
+  return false;
+}
+
 /** Write through a temporary file renamed into place: a failure leaves no partial
  * file. PCL's writers print their own complaints; the tool prints one line instead. */
 template <typename Write>
@@ -74,9 +269,14 @@ writeAtomically(const std::string& path, const Write& write, std::string& error)
   return true;
 }
 
-/** Read whitespace-separated x y z lines; '#' starts a comment. */
+/** Read whitespace-separated x y z lines; '#' starts a comment. With \a obj, only
+ * the vertex lines ("v x y z") of a Wavefront file count. PCL's OBJ reader crashes on
+ * a vertex line with fewer than three numbers, so OBJ files are read here too. */
 bool
-readText(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error)
+readText(const std::string& path,
+         pcl::PCLPointCloud2& cloud,
+         std::string& error,
+         bool obj = false)
 {
   std::ifstream in(path);
   std::vector<float> xyz;
@@ -88,6 +288,11 @@ readText(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error
     if (hash != std::string::npos)
       line.resize(hash);
     std::istringstream fields(line);
+    if (obj) {
+      std::string tag;
+      if (!(fields >> tag) || tag != "v")
+        continue; // faces, normals, texture coordinates, groups, ...
+    }
     double v[3];
     int n = 0;
     while (n < 3 && fields >> v[n])
@@ -95,7 +300,8 @@ readText(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error
     if (n == 0 && fields.eof())
       continue; // blank line
     if (n < 3) {
-      error = "line " + std::to_string(number) + " is not 'x y z'";
+      error = "line " + std::to_string(number) +
+              (obj ? " is not 'v x y z'" : " is not 'x y z'");
       return false;
     }
     for (const double c : v)
@@ -172,26 +378,21 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
   bool ok = true;
   try {
     if (ext == "pcd") {
-      // PCL's reader crashes on some malformed files whose header it rejects: read
-      // the header first.
-      pcl::PCDReader reader;
-      Eigen::Vector4f origin;
-      Eigen::Quaternionf orientation;
-      int version = 0, type = 0;
-      unsigned int data_start = 0;
-      status = reader.readHeader(
-          path, cloud, origin, orientation, version, type, data_start);
-      if (status >= 0 && (cloud.fields.empty() || cloud.point_step == 0))
-        status = -1;
-      if (status >= 0)
-        status = reader.read(path, cloud);
+      // PCL's reader trusts the header: it allocates what it says (a negative SIZE
+      // became 17 GB) and crashes on some malformed ones. Check it first.
+      if (checkPcdHeader(path, error))
+        status = pcl::io::loadPCDFile(path, cloud);
+      else
+        ok = false;
     }
-    else if (ext == "ply")
-      status = pcl::io::loadPLYFile(path, cloud);
-    else if (ext == "obj")
-      status = pcl::io::loadOBJFile(path, cloud);
+    else if (ext == "ply") {
+      if (checkPlyHeader(path, error))
+        status = pcl::io::loadPLYFile(path, cloud);
+      else
+        ok = false;
+    }
     else
-      ok = readText(path, cloud, error);
+      ok = readText(path, cloud, error, ext == "obj");
   }
   catch (const std::exception& e) {
     status = -1;

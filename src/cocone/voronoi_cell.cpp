@@ -6,7 +6,9 @@
 #include <pcl/surface/cocone/voronoi_cell.h>
 
 #include "points.h"
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -137,7 +139,11 @@ atomicRaise(int* target, int x, const Less& less)
 int
 resolveThreads(unsigned int requested)
 {
+#ifdef _OPENMP
   const int available = std::max(1, omp_get_num_procs());
+#else
+  const int available = 1;
+#endif
   return requested == 0 ? available : static_cast<int>(requested);
 }
 
@@ -295,7 +301,11 @@ computeVoronoiCells(const Triangulation& dt,
   std::vector<std::vector<CoconeTriangle>> found(threads);
 #pragma omp parallel num_threads(threads)
   {
+#ifdef _OPENMP
     auto& mine = found[omp_get_thread_num()];
+#else
+    auto& mine = found[0];
+#endif
 #pragma omp for schedule(static)
     for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
       for (int i = 0; i < 4; ++i) {

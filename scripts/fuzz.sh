@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Build the libFuzzer targets with clang, replay the kept corpus (every input that
+# ever crashed stays there as a regression), then fuzz each target for a while.
+#   bash scripts/fuzz.sh [SECONDS]     (default 60 per target)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+bash scripts/install_deps.sh
+build=${BUILD_DIR:-build-fuzz}
+CC=clang CXX=clang++ cmake -S fuzz -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
+cmake --build "$build" -j"$(nproc)"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+for target in pipeline readers; do
+  echo "== fuzz_$target: replaying fuzz/corpus/$target"
+  "$build/fuzz_$target" -rss_limit_mb=2048 fuzz/corpus/$target/* > "$work/replay.log" 2>&1 ||
+    { cat "$work/replay.log"; exit 1; }
+  mkdir -p "$work/$target"
+  cp fuzz/corpus/$target/* "$work/$target/"
+  echo "== fuzz_$target: fuzzing for $seconds s"
+  (cd "$work" && "$OLDPWD/$build/fuzz_$target" "$target" -max_total_time="$seconds" \
+     -rss_limit_mb=2048 -print_final_stats=1 > "fuzz_$target.log" 2>&1) ||
+    { tail -40 "$work/fuzz_$target.log"; ls "$work"; exit 1; }
+  grep -E "stat::number_of_executed_units|stat::new_units_added" "$work/fuzz_$target.log"
+done
