@@ -518,6 +518,135 @@ checkWritable(const std::string& path, std::string& error)
   return true;
 }
 
+namespace {
+
+/** x, y, z of point i in double, whatever the fields' types. */
+Eigen::Vector3d
+pointAt(const pcl::PCLPointCloud2& cloud, const int (&xyz)[3], std::size_t i)
+{
+  Eigen::Vector3d p;
+  const std::uint8_t* base = cloud.data.data() + i * cloud.point_step;
+  for (int k = 0; k < 3; ++k) {
+    const auto& f = cloud.fields[xyz[k]];
+    if (f.datatype == pcl::PCLPointField::FLOAT64)
+      std::memcpy(&p[k], base + f.offset, 8);
+    else {
+      float v;
+      std::memcpy(&v, base + f.offset, 4);
+      p[k] = v;
+    }
+  }
+  return p;
+}
+
+/** Colour of point i as 0xRRGGBB, or -1 without a colour field. */
+long
+colourAt(const pcl::PCLPointCloud2& cloud, int field, std::size_t i)
+{
+  if (field < 0)
+    return -1;
+  std::uint32_t rgb;
+  std::memcpy(
+      &rgb, cloud.data.data() + i * cloud.point_step + cloud.fields[field].offset, 4);
+  return rgb & 0xffffff;
+}
+
+/** Legacy VTK (what pcl_viewer opens) in double precision: PCL's writer only takes
+ * float coordinates and keeps 5 digits by default. */
+bool
+writeVtk(const std::string& path, const pcl::PolygonMesh& mesh, const int (&xyz)[3])
+{
+  const auto& c = mesh.cloud;
+  const std::size_t n = std::size_t(c.width) * c.height;
+  std::ofstream f(path);
+  f.precision(17);
+  f << "# vtk DataFile Version 3.0\npcl_cocone_reconstruction\nASCII\nDATASET "
+       "POLYDATA\nPOINTS "
+    << n << " double\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = pointAt(c, xyz, i);
+    f << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  }
+  f << "POLYGONS " << mesh.polygons.size() << ' ' << 4 * mesh.polygons.size() << '\n';
+  for (const auto& t : mesh.polygons)
+    f << "3 " << t.vertices[0] << ' ' << t.vertices[1] << ' ' << t.vertices[2] << '\n';
+  const int rgb = std::max(pcl::getFieldIndex(c, "rgb"), pcl::getFieldIndex(c, "rgba"));
+  if (rgb >= 0) {
+    f << "POINT_DATA " << n << "\nCOLOR_SCALARS scalars 3\n";
+    f.precision(6);
+    for (std::size_t i = 0; i < n; ++i) {
+      const long v = colourAt(c, rgb, i);
+      f << ((v >> 16) & 255) / 255.0 << ' ' << ((v >> 8) & 255) / 255.0 << ' '
+        << (v & 255) / 255.0 << '\n';
+    }
+  }
+  return static_cast<bool>(f);
+}
+
+/** Wavefront OBJ with full precision. */
+bool
+writeObj(const std::string& path, const pcl::PolygonMesh& mesh, const int (&xyz)[3])
+{
+  const auto& c = mesh.cloud;
+  const std::size_t n = std::size_t(c.width) * c.height;
+  std::ofstream f(path);
+  f.precision(17);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = pointAt(c, xyz, i);
+    f << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  }
+  for (const auto& t : mesh.polygons)
+    f << "f " << t.vertices[0] + 1 << ' ' << t.vertices[1] + 1 << ' '
+      << t.vertices[2] + 1 << '\n';
+  return static_cast<bool>(f);
+}
+
+/** Binary PLY whose vertices carry every field of the cloud in its own type (colour
+ * as red, green, blue). */
+bool
+writePly(const std::string& path, const pcl::PolygonMesh& mesh)
+{
+  static const char* PLY_TYPE[] = {
+      nullptr, "char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
+  const auto& c = mesh.cloud;
+  const std::size_t n = std::size_t(c.width) * c.height;
+  std::ofstream f(path, std::ios::binary);
+  f << "ply\nformat binary_little_endian 1.0\ncomment pcl_cocone_reconstruction\n"
+    << "element vertex " << n << '\n';
+  std::vector<const pcl::PCLPointField*> fields;
+  for (const auto& field : c.fields) {
+    if (field.count != 1 || field.datatype < 1 || field.datatype > 8 ||
+        field.name == "_")
+      continue;
+    fields.push_back(&field);
+    if (field.name == "rgb" || field.name == "rgba")
+      f << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    else
+      f << "property " << PLY_TYPE[field.datatype] << ' ' << field.name << '\n';
+  }
+  f << "element face " << mesh.polygons.size()
+    << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (std::size_t i = 0; i < n; ++i)
+    for (const auto* field : fields) {
+      const std::uint8_t* v = c.data.data() + i * c.point_step + field->offset;
+      if (field->name == "rgb" || field->name == "rgba") {
+        const std::uint8_t rgb[3] = {v[2], v[1], v[0]};
+        f.write(reinterpret_cast<const char*>(rgb), 3);
+      }
+      else
+        f.write(reinterpret_cast<const char*>(v), pcl::getFieldSize(field->datatype));
+    }
+  for (const auto& t : mesh.polygons) {
+    const std::uint8_t three = 3;
+    const std::int32_t v[3] = {t.vertices[0], t.vertices[1], t.vertices[2]};
+    f.write(reinterpret_cast<const char*>(&three), 1);
+    f.write(reinterpret_cast<const char*>(v), sizeof(v));
+  }
+  return static_cast<bool>(f);
+}
+
+} // namespace
+
 bool
 writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& error)
 {
@@ -526,15 +655,23 @@ writeMesh(const std::string& path, const pcl::PolygonMesh& mesh, std::string& er
     error = "unknown output format '" + ext + "' (use .vtk, .ply, .obj or .stl)";
     return false;
   }
+  int xyz[3];
+  for (int k = 0; k < 3; ++k)
+    if ((xyz[k] = pcl::getFieldIndex(mesh.cloud, std::string(1, "xyz"[k]))) < 0) {
+      error = "cannot write '" + path + "': no x/y/z";
+      return false;
+    }
+  // The text formats and PLY are written here so that double coordinates (lidar in
+  // UTM) keep every digit; STL is single precision by definition.
   return writeAtomically(
       path,
       [&](const std::string& tmp) {
         if (ext == "vtk")
-          return pcl::io::saveVTKFile(tmp, mesh, 10) >= 0;
+          return writeVtk(tmp, mesh, xyz);
         if (ext == "ply")
-          return pcl::io::savePLYFileBinary(tmp, mesh) >= 0;
+          return writePly(tmp, mesh);
         if (ext == "obj")
-          return pcl::io::saveOBJFile(tmp, mesh, 10) >= 0;
+          return writeObj(tmp, mesh, xyz);
         return pcl::io::savePolygonFileSTL(tmp, mesh, true);
       },
       error);

@@ -20,6 +20,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -250,6 +251,71 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
     EXPECT_NE(log.find(c.second), std::string::npos) << c.first << ": " << log;
     EXPECT_NE(log.find("Error"), std::string::npos) << c.first;
     EXPECT_FALSE(exists(out)) << c.first << " left " << out;
+  }
+}
+
+TEST_F(Tool, GeoreferencedDoubleCoordinates)
+{
+  // Lidar in UTM: x, y, z as 8-byte fields around (5e6, 5e6, 1e3). The tool gives the
+  // result it gives at the origin and writes the coordinates back unchanged.
+  const auto write = [&](const std::string& path, const Eigen::Vector3d& offset) {
+    pcl::PCLPointCloud2 blob;
+    for (int k = 0; k < 3; ++k) {
+      pcl::PCLPointField f;
+      f.name = std::string(1, "xyz"[k]);
+      f.offset = 8 * k;
+      f.datatype = pcl::PCLPointField::FLOAT64;
+      f.count = 1;
+      blob.fields.push_back(f);
+    }
+    blob.point_step = 24;
+    blob.width = static_cast<std::uint32_t>(cloud_->size());
+    blob.height = 1;
+    blob.row_step = blob.point_step * blob.width;
+    blob.data.resize(blob.row_step);
+    for (std::size_t i = 0; i < cloud_->size(); ++i) {
+      // Points on a 2^-10 grid: exact in double after the offset.
+      const Eigen::Vector3d p =
+          (cloud_->at(i).getVector3fMap().cast<double>() * 1024.0).array().round() /
+              1024.0 +
+          offset.array();
+      std::memcpy(&blob.data[i * 24], p.data(), 24);
+    }
+    pcl::io::savePCDFile(
+        path, blob, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), true);
+  };
+  const Eigen::Vector3d utm(5e6, 5e6, 1e3);
+  write(dir_ + "/origin.pcd", Eigen::Vector3d::Zero());
+  write(dir_ + "/utm.pcd", utm);
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/origin.pcd " + dir_ + "/origin.ply -q -boundary " + dir_ +
+                    "/origin_b.pcd",
+                &log),
+            0)
+      << log;
+  ASSERT_EQ(
+      run(dir_ + "/utm.pcd " + dir_ + "/utm.ply -q -boundary " + dir_ + "/utm_b.pcd",
+          &log),
+      0)
+      << log;
+  pcl::PolygonMesh a, b;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/origin.ply", a), 0);
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/utm.ply", b), 0);
+  ASSERT_EQ(a.polygons.size(), b.polygons.size());
+  for (std::size_t i = 0; i < a.polygons.size(); ++i)
+    EXPECT_EQ(a.polygons[i].vertices, b.polygons[i].vertices);
+  // The boundary points keep their double coordinates, bit for bit.
+  pcl::PCLPointCloud2 in, out;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/utm.pcd", in), 0);
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/utm_b.pcd", out), 0);
+  ASSERT_GT(out.width, 0u);
+  const int index = pcl::getFieldIndex(out, "index");
+  ASSERT_GE(index, 0);
+  for (std::size_t j = 0; j < out.width; ++j) {
+    std::uint32_t i;
+    std::memcpy(&i, &out.data[j * out.point_step + out.fields[index].offset], 4);
+    EXPECT_EQ(
+        std::memcmp(&out.data[j * out.point_step], &in.data[i * in.point_step], 24), 0);
   }
 }
 
