@@ -7,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "radix_sort.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -47,9 +49,8 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
       inc.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), k});
     }
   }
-  std::sort(inc.begin(), inc.end(), [](const Incidence& a, const Incidence& b) {
-    return a.key < b.key || (a.key == b.key && a.t < b.t);
-  });
+  // Generated in triangle order: a stable sort by key keeps it within each edge.
+  detail::radixSortByKey(inc);
   triangle_edges_.resize(m);
   edge_first_.push_back(0);
   edge_triangles_.reserve(inc.size());

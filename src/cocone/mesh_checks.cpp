@@ -5,6 +5,8 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
+#include "radix_sort.h"
+
 #include <algorithm>
 #include <numeric>
 
@@ -57,9 +59,8 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
       items.push_back(
           {std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), a < b});
     }
-  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
-    return a.key < b.key || (a.key == b.key && a.t < b.t);
-  });
+  // Generated in triangle order: a stable sort by key keeps it within each edge.
+  detail::radixSortByKey(items);
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (i == 0 || items[i].key != items[i - 1].key) {
       first.push_back(i);
