@@ -38,9 +38,10 @@ compact(std::vector<Triangle>& triangles, const std::vector<std::uint8_t>& drop)
 
 /** At every edge with more than two triangles keep the best pair. */
 std::size_t
-resolveEdges(const std::vector<Eigen::Vector3d>& P, std::vector<Triangle>& triangles)
+resolveEdges(const std::vector<Eigen::Vector3d>& P,
+             std::vector<Triangle>& triangles,
+             const EdgeIncidences& inc)
 {
-  const EdgeIncidences inc(triangles);
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   bool any = false;
   for (std::size_t e = 0; e < inc.edges.size(); ++e) {
@@ -106,9 +107,11 @@ resolveVertices(std::vector<Triangle>& triangles, std::size_t num_vertices)
 std::size_t
 orient(const std::vector<Eigen::Vector3d>& P,
        std::vector<Triangle>& triangles,
+       const EdgeIncidences& inc,
        std::size_t& flipped)
 {
-  const EdgeIncidences inc(triangles);
+  // inc's edges and triangles stay valid while triangles are turned over; the
+  // direction of traversal is read from the triangles themselves.
   const std::size_t m = triangles.size();
   // Per triangle: its edges' ids, found through the incidences.
   std::vector<std::array<int, 3>> tri_edges(m);
@@ -181,7 +184,8 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                RepairCounts& counts)
 {
   for (;;) {
-    if (const std::size_t d = resolveEdges(points, triangles)) {
+    const EdgeIncidences inc(triangles);
+    if (const std::size_t d = resolveEdges(points, triangles, inc)) {
       counts.nonmanifold_edge += d;
       continue;
     }
@@ -189,7 +193,7 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
       counts.nonmanifold_vertex += d;
       continue;
     }
-    const std::size_t d = orient(points, triangles, counts.flipped);
+    const std::size_t d = orient(points, triangles, inc, counts.flipped);
     if (d == 0)
       return;
     counts.orientation += d;
