@@ -3,7 +3,8 @@
 # Does nothing when they are all present.
 set -euo pipefail
 packages=(cmake g++ make libpcl-dev libcgal-dev libeigen3-dev libflann-dev libtbb-dev
-          libgtest-dev pcl-tools xvfb xauth python3-catkin-pkg clang libclang-rt-14-dev)
+          libgtest-dev pcl-tools xvfb xauth python3-catkin-pkg clang libclang-rt-14-dev
+          doxygen)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -58,7 +58,9 @@ namespace pcl {
 template <typename PointInT>
 class CoConeBoundary : public SurfaceReconstruction<PointInT> {
 public:
+  /** \brief Shared pointer to the class. */
   using Ptr = shared_ptr<CoConeBoundary<PointInT>>;
+  /** \brief Shared pointer to a const instance. */
   using ConstPtr = shared_ptr<const CoConeBoundary<PointInT>>;
 
   /** \brief Constructor: the automatic ratio with the spacing test, theta = pi / 6,
@@ -264,15 +266,19 @@ protected:
   using SurfaceReconstruction<PointInT>::deinitCompute;
   using SurfaceReconstruction<PointInT>::check_tree_;
 
+  /** \brief The class name, for PCL's messages. */
   std::string
   getClassName() const override
   {
     return "CoConeBoundary";
   }
 
+  /** \brief Run the pipeline and fill the mesh's polygons (the base class has copied
+   * the input cloud into it); on error an empty mesh. */
   void
   performReconstruction(pcl::PolygonMesh& output) override;
 
+  /** \brief Run the pipeline; \a points becomes a copy of the input cloud. */
   void
   performReconstruction(pcl::PointCloud<PointInT>& points,
                         std::vector<pcl::Vertices>& polygons) override;

@@ -29,18 +29,21 @@ public:
   TriangleComplex(const std::vector<Eigen::Vector3d>& points,
                   std::vector<Triangle> triangles);
 
+  /** Number of triangles. */
   std::size_t
   numTriangles() const
   {
     return triangles_.size();
   }
 
+  /** Number of edges. */
   std::size_t
   numEdges() const
   {
     return edges_.size();
   }
 
+  /** Vertex positions. */
   const std::vector<Eigen::Vector3d>&
   points() const
   {
@@ -75,6 +78,7 @@ public:
     return edge_first_[e];
   }
 
+  /** End of the incidences of edge e (see edgeBegin()). */
   std::size_t
   edgeEnd(int e) const
   {
@@ -102,12 +106,14 @@ public:
     return vertex_first_[v];
   }
 
+  /** End of the triangles of vertex v (see vertexBegin()). */
   std::size_t
   vertexEnd(int v) const
   {
     return vertex_first_[v + 1];
   }
 
+  /** Triangle of vertex incidence i. */
   int
   vertexTriangle(std::size_t i) const
   {

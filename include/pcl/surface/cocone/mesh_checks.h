@@ -19,13 +19,15 @@ namespace cocone {
  * it from the lower to the higher vertex id.
  */
 struct EdgeIncidences {
-  std::vector<std::array<int, 2>> edges; // end points, ascending
-  std::vector<std::size_t> first;        // CSR offsets, size edges + 1
-  std::vector<int> triangle;             // per incidence
-  std::vector<std::uint8_t> forward;     // per incidence: traverses lower -> higher
+  std::vector<std::array<int, 2>> edges; ///< end points, ascending
+  std::vector<std::size_t> first;        ///< CSR offsets, size edges + 1
+  std::vector<int> triangle;             ///< per incidence
+  std::vector<std::uint8_t> forward;     ///< per incidence: traverses lower -> higher
 
+  /** Group the edges of \a oriented. */
   explicit EdgeIncidences(const std::vector<Triangle>& oriented);
 
+  /** Number of triangles at edge e. */
   std::size_t
   count(std::size_t e) const
   {
@@ -46,16 +48,16 @@ vertexFans(const std::vector<Triangle>& oriented,
 
 /** \brief Topology of an oriented triangle mesh. */
 struct MeshTopology {
-  std::size_t vertices = 0; // vertices used by a triangle
-  std::size_t edges = 0;
-  std::size_t triangles = 0;
-  std::size_t boundary_edges = 0;
-  std::size_t nonmanifold_edges = 0;     // in more than two triangles
-  std::size_t nonmanifold_vertices = 0;  // more than one fan
-  std::size_t orientation_conflicts = 0; // edges traversed twice the same way
-  std::size_t components = 0;            // through shared edges
-  std::size_t closed_components = 0;     // components without boundary edges
-  long euler = 0;                        // V - E + F
+  std::size_t vertices = 0;              ///< vertices used by a triangle
+  std::size_t edges = 0;                 ///< distinct edges
+  std::size_t triangles = 0;             ///< triangles
+  std::size_t boundary_edges = 0;        ///< edges in one triangle
+  std::size_t nonmanifold_edges = 0;     ///< in more than two triangles
+  std::size_t nonmanifold_vertices = 0;  ///< more than one fan
+  std::size_t orientation_conflicts = 0; ///< edges traversed twice the same way
+  std::size_t components = 0;            ///< through shared edges
+  std::size_t closed_components = 0;     ///< components without boundary edges
+  long euler = 0;                        ///< V - E + F
 
   /** Valid oriented 2-manifold with boundary. */
   bool

@@ -27,9 +27,9 @@ struct Parameters {
    * the paper's test. */
   double spacing_factor = 3.0;
   /** Normal angle theta in radians. */
-  double normal_angle = 0.5235987755982988; // pi / 6
+  double normal_angle = 0.5235987755982988; ///< pi / 6
   /** Co-cone angle in radians. */
-  double cocone_angle = 1.1780972450961724; // 3 pi / 8
+  double cocone_angle = 1.1780972450961724; ///< 3 pi / 8
   /** false: every vertex counts as interior (the original Co-cone). */
   bool boundary_detection = true;
   /** Which triangles the interior vertices choose (stage 4). */
@@ -43,23 +43,23 @@ struct Parameters {
 
 /** \brief Sizes of the intermediate results of stages 4-7. */
 struct ReconstructionCounts {
-  std::size_t candidates = 0;        // stage 4
-  std::size_t umbrella_failures = 0; // stage 5
-  std::size_t pruned = 0;            // stage 6: triangles removed
-  std::size_t walk_components = 0;   // stage 7: components of the pruned complex
-  std::size_t walked = 0;            // stage 7: triangles the walk kept
-  std::size_t walk_conflicts = 0; // stage 7: triangles reached with both orientations
-  std::size_t walk_reseeds = 0;   // stage 7: walks started after one per component
-  RepairCounts repair;            // changes by the manifold repair
+  std::size_t candidates = 0;        ///< stage 4
+  std::size_t umbrella_failures = 0; ///< stage 5
+  std::size_t pruned = 0;            ///< stage 6: triangles removed
+  std::size_t walk_components = 0;   ///< stage 7: components of the pruned complex
+  std::size_t walked = 0;            ///< stage 7: triangles the walk kept
+  std::size_t walk_conflicts = 0; ///< stage 7: triangles reached with both orientations
+  std::size_t walk_reseeds = 0;   ///< stage 7: walks started after one per component
+  RepairCounts repair;            ///< changes by the manifold repair
 };
 
 /** \brief Wall-clock time of each stage, in milliseconds. */
 struct Timings {
-  double unique = 0.0;
-  double delaunay = 0.0;
-  double voronoi = 0.0;
-  double boundary = 0.0;
-  double reconstruction = 0.0;
+  double unique = 0.0;         ///< merging duplicates, numbering the vertices
+  double delaunay = 0.0;       ///< stage 1
+  double voronoi = 0.0;        ///< stage 2
+  double boundary = 0.0;       ///< stage 3
+  double reconstruction = 0.0; ///< stages 4-7 and the repair
 };
 
 /** \brief What the pipeline returns.
@@ -85,8 +85,9 @@ struct Result {
   std::vector<int> boundary_indices;
   /** Per vertex: the caller id that stands for it in polygons (its lowest). */
   std::vector<int> representative;
-  /** Vertex positions (recentred) and the offset to add back. */
+  /** Vertex positions, recentred: a point is positions[v] + offset. */
   std::vector<Eigen::Vector3d> positions;
+  /** The offset subtracted before triangulating. */
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   /** The output mesh: oriented triangles over vertex ids. */
   std::vector<Triangle> triangles;
@@ -98,7 +99,9 @@ struct Result {
    * vertices the area-weighted normal of their triangles); NaN when the vertex is not
    * in the mesh. */
   std::vector<Eigen::Vector3d> normals;
+  /** Sizes of the intermediate results of stages 4-7. */
   ReconstructionCounts counts;
+  /** Wall-clock time of each stage. */
   Timings timings;
 };
 

@@ -27,6 +27,7 @@ struct RepairCounts {
   /** Added to close holes of three edges (single missing triangles). */
   std::size_t filled = 0;
 
+  /** Triangles dropped in all. */
   std::size_t
   dropped() const
   {
