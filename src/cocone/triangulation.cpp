@@ -135,7 +135,7 @@ tetrahedronCircumcenter(const Eigen::Vector3d& a,
   const Eigen::Vector3d num =
       u.squaredNorm() * vw + v.squaredNorm() * wu + w.squaredNorm() * uv;
   if (den != 0.0) {
-    const Eigen::Vector3d cc = a + num / den;
+    Eigen::Vector3d cc = a + num / den;
     if (isFinite(cc))
       return cc;
   }
@@ -155,8 +155,7 @@ triangleCircumcenter(const Eigen::Vector3d& a,
   const Eigen::Vector3d n = u.cross(v);
   const double den = 2.0 * n.squaredNorm();
   if (den != 0.0) {
-    const Eigen::Vector3d cc =
-        a + (u.squaredNorm() * v - v.squaredNorm() * u).cross(n) / den;
+    Eigen::Vector3d cc = a + (u.squaredNorm() * v - v.squaredNorm() * u).cross(n) / den;
     if (isFinite(cc))
       return cc;
   }
