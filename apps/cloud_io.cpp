@@ -12,7 +12,9 @@
 #include <pcl/io/ply_io.h>
 #include <pcl/io/vtk_io.h>
 #include <pcl/io/vtk_lib_io.h>
+#include <pcl/conversions.h>
 #include <pcl/PCLPointField.h>
+#include <pcl/point_types.h>
 
 #include <unistd.h>
 
@@ -311,22 +313,11 @@ readText(const std::string& path,
     error = "no points";
     return false;
   }
-  cloud = pcl::PCLPointCloud2();
-  for (int k = 0; k < 3; ++k) {
-    pcl::PCLPointField f;
-    f.name = std::string(1, "xyz"[k]);
-    f.offset = 4 * k;
-    f.datatype = pcl::PCLPointField::FLOAT32;
-    f.count = 1;
-    cloud.fields.push_back(f);
-  }
-  cloud.point_step = 12;
-  cloud.width = static_cast<std::uint32_t>(xyz.size() / 3);
-  cloud.height = 1;
-  cloud.row_step = cloud.point_step * cloud.width;
-  cloud.is_dense = false;
-  cloud.data.resize(xyz.size() * sizeof(float));
-  std::memcpy(cloud.data.data(), xyz.data(), cloud.data.size());
+  pcl::PointCloud<pcl::PointXYZ> points;
+  for (std::size_t i = 0; i < xyz.size(); i += 3)
+    points.push_back(pcl::PointXYZ(xyz[i], xyz[i + 1], xyz[i + 2]));
+  points.is_dense = false;
+  pcl::toPCLPointCloud2(points, cloud);
   return true;
 }
 
