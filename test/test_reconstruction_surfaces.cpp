@@ -14,9 +14,12 @@
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <numeric>
 #include <ostream>
+#include <random>
 
 using cocone_test::options;
 using cocone_test::paper;
@@ -315,18 +318,27 @@ TEST(Reconstruction, Deterministic)
     EXPECT_EQ(p.polygons, a.polygons) << threads << " threads";
     EXPECT_EQ(p.boundary_indices, a.boundary_indices) << threads << " threads";
   }
-  // The input order does not matter: reverse the points and map back.
-  std::vector<Eigen::Vector3d> reversed(s.points.rbegin(), s.points.rend());
+  // The input order does not matter: shuffle the points and map back.
+  std::vector<int> order(s.points.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(11));
+  std::vector<Eigen::Vector3d> shuffled;
+  for (const int i : order)
+    shuffled.push_back(s.points[i]);
   const Result c =
-      pcl::cocone::run(reversed, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
-  const int n = static_cast<int>(s.points.size());
+      pcl::cocone::run(shuffled, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
   std::vector<pcl::cocone::Triangle> mapped;
   for (auto t : c.polygons) {
     for (auto& v : t)
-      v = n - 1 - v;
+      v = order[v];
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
     mapped.push_back(t);
   }
+  std::vector<int> border;
+  for (const int i : c.boundary_indices)
+    border.push_back(order[i]);
+  std::sort(border.begin(), border.end());
+  EXPECT_EQ(border, a.boundary_indices);
   std::sort(mapped.begin(), mapped.end());
   std::vector<pcl::cocone::Triangle> original = a.polygons;
   for (auto& t : original)

@@ -18,11 +18,15 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -317,6 +321,74 @@ TEST_F(Tool, GeoreferencedDoubleCoordinates)
     EXPECT_EQ(
         std::memcmp(&out.data[j * out.point_step], &in.data[i * in.point_step], 24), 0);
   }
+}
+
+TEST_F(Tool, DeterministicAcrossRunsThreadsAndInputOrder)
+{
+  const auto slurp = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)),
+                       std::istreambuf_iterator<char>());
+  };
+  // Repeated runs and any number of threads: the same bytes.
+  std::string log;
+  for (const char* threads : {"1", "1", "0", "3"}) {
+    const std::string name = dir_ + "/det" + threads;
+    ASSERT_EQ(run(dir_ + "/in.pcd " + name + ".ply -q -threads " + threads +
+                      " -boundary " + name + "_b.pcd",
+                  &log),
+              0)
+        << log;
+    EXPECT_EQ(slurp(name + ".ply"), slurp(dir_ + "/det1.ply")) << threads;
+    EXPECT_EQ(slurp(name + "_b.pcd"), slurp(dir_ + "/det1_b.pcd")) << threads;
+  }
+
+  // A shuffled cloud: the same mesh and boundary up to the permutation.
+  std::vector<int> order(cloud_->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  pcl::PointCloud<pcl::PointXYZ> shuffled;
+  for (const int i : order)
+    shuffled.push_back(cloud_->at(i));
+  pcl::io::savePCDFileBinary(dir_ + "/shuffled.pcd", shuffled);
+  ASSERT_EQ(run(dir_ + "/shuffled.pcd " + dir_ + "/shuffled.ply -q -threads 0 " +
+                    "-boundary " + dir_ + "/shuffled_b.pcd",
+                &log),
+            0)
+      << log;
+  const auto triangles = [](const std::string& path, const std::vector<int>* map) {
+    pcl::PolygonMesh mesh;
+    EXPECT_EQ(pcl::io::loadPLYFile(path, mesh), 0) << path;
+    std::vector<std::array<int, 3>> out;
+    for (const auto& polygon : mesh.polygons) {
+      std::array<int, 3> t;
+      for (int k = 0; k < 3; ++k)
+        t[k] = map ? (*map)[polygon.vertices[k]] : int(polygon.vertices[k]);
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+      out.push_back(t);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  const auto boundary = [](const std::string& path, const std::vector<int>* map) {
+    pcl::PCLPointCloud2 blob;
+    EXPECT_EQ(pcl::io::loadPCDFile(path, blob), 0) << path;
+    const int field = pcl::getFieldIndex(blob, "index");
+    std::vector<int> out;
+    for (std::size_t j = 0; field >= 0 && j < blob.width * blob.height; ++j) {
+      std::uint32_t i;
+      std::memcpy(&i, &blob.data[j * blob.point_step + blob.fields[field].offset], 4);
+      out.push_back(map ? (*map)[i] : int(i));
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  const auto original = triangles(dir_ + "/det1.ply", nullptr);
+  ASSERT_GT(original.size(), 1000u);
+  EXPECT_EQ(triangles(dir_ + "/shuffled.ply", &order), original);
+  const auto border = boundary(dir_ + "/det1_b.pcd", nullptr);
+  ASSERT_FALSE(border.empty());
+  EXPECT_EQ(boundary(dir_ + "/shuffled_b.pcd", &order), border);
 }
 
 TEST_F(Tool, FuzzCorpusFailsCleanly)
