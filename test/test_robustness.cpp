@@ -13,9 +13,13 @@
 #include <gtest/gtest.h>
 
 #include <support/surfaces.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <memory>
 
 namespace {
 
@@ -200,3 +204,42 @@ TEST(Robustness, NearDuplicates)
   EXPECT_TRUE(pcl::cocone::analyzeMesh(r.triangles, r.vertices).manifold());
   EXPECT_GT(r.triangles.size(), s.points.size());
 }
+
+#if !defined(__SANITIZE_ADDRESS__) && !defined(COCONE_SANITIZE)
+TEST(Robustness, OutOfMemoryIsAnErrorNotATermination)
+{
+  // Cap the address space a little above what the process holds: the pipeline's
+  // allocations fail, and it reports it instead of terminating. (Not under
+  // AddressSanitizer, which reserves terabytes of address space.)
+  cocone_test::SampleOptions o;
+  o.n = 100000;
+  o.even = false;
+  const auto s = cocone_test::torus(o);
+  auto cloud = std::make_shared<Cloud>();
+  for (const auto& p : s.points)
+    cloud->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  pcl::PolygonMesh mesh;
+
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0;
+  statm >> pages;
+  ASSERT_GT(pages, 0u);
+  rlimit old;
+  ASSERT_EQ(::getrlimit(RLIMIT_AS, &old), 0);
+  rlimit capped = old;
+  capped.rlim_cur = pages * ::sysconf(_SC_PAGESIZE) + (32u << 20);
+  ASSERT_EQ(::setrlimit(RLIMIT_AS, &capped), 0);
+  cocone.reconstruct(mesh);
+  ASSERT_EQ(::setrlimit(RLIMIT_AS, &old), 0);
+
+  EXPECT_TRUE(mesh.polygons.empty());
+  pcl::PointIndices boundary;
+  cocone.getBoundaryPointIndices(boundary);
+  EXPECT_TRUE(boundary.indices.empty());
+  // With the memory back, the same object succeeds.
+  cocone.reconstruct(mesh);
+  EXPECT_GT(mesh.polygons.size(), 190000u);
+}
+#endif

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -43,9 +44,14 @@ TEST(Triangulate, DimensionOfDegenerateInput)
   EXPECT_EQ(triangulate({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}).dimension, 1);
   const Triangulation flat = triangulate({{0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
   EXPECT_EQ(flat.dimension, 2);
-  EXPECT_EQ(flat.cells.size(), 2u);
-  for (const auto& c : flat.cells)
-    EXPECT_EQ(c[3], -1);
+  EXPECT_EQ(flat.number_of_cells, 2u);
+  std::size_t visited = 0;
+  forEachCell(flat, 0, 1, [&](const CellView& c, int) {
+    EXPECT_EQ(c.corners, 3);
+    EXPECT_EQ(c.v[3], -1);
+    ++visited;
+  });
+  EXPECT_EQ(visited, 2u);
 }
 
 TEST(Triangulate, CellsNeighboursAndCircumcenters)
@@ -55,28 +61,47 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
     P.emplace_back(std::sin(i * 1.7), std::cos(i * 2.3), std::sin(i * 0.9 + 1.0));
   const Triangulation dt = triangulate(makeUniquePoints(P).points);
   ASSERT_EQ(dt.dimension, 3);
-  ASSERT_EQ(dt.cells.size(), dt.circumcenters.size());
-  std::size_t hull_facets = 0;
-  for (std::size_t c = 0; c < dt.cells.size(); ++c) {
-    // The circumcenter is equidistant from the four vertices.
-    const double r = (dt.circumcenters[c] - dt.points[dt.cells[c][0]]).norm();
-    for (int i = 1; i < 4; ++i)
-      EXPECT_NEAR(
-          (dt.circumcenters[c] - dt.points[dt.cells[c][i]]).norm(), r, 1e-9 * r);
-    for (int i = 0; i < 4; ++i) {
-      const int nb = dt.neighbors[c][i];
-      if (nb < 0) {
-        ++hull_facets;
-        continue;
-      }
-      // Adjacency is symmetric.
-      int back = 0;
-      for (int j = 0; j < 4; ++j)
-        back += dt.neighbors[nb][j] == static_cast<int>(c);
-      EXPECT_EQ(back, 1);
+  for (const int threads : {1, 2}) {
+    // Per thread: cells, hull, own and shared facets.
+    std::vector<std::array<std::size_t, 4>> count(threads, {0, 0, 0, 0});
+    forEachCell(
+        dt,
+        CellView::CIRCUMCENTER | CellView::NEIGHBORS,
+        threads,
+        [&](const CellView& c, int thread) {
+          ASSERT_LT(thread, threads);
+          auto& [cells, hull, own, shared] = count[thread];
+          ++cells;
+          // The circumcenter is equidistant from the four vertices.
+          const double r = (c.circumcenter - dt.points[c.v[0]]).norm();
+          for (int i = 1; i < 4; ++i)
+            EXPECT_NEAR((c.circumcenter - dt.points[c.v[i]]).norm(), r, 1e-9 * r);
+          for (int i = 0; i < 4; ++i) {
+            hull += c.facet[i] == FacetRole::HULL;
+            shared += c.facet[i] == FacetRole::SHARED;
+            if (c.facet[i] == FacetRole::OWN) {
+              ++own;
+              // The neighbour's circumcenter is equidistant from the shared facet.
+              const Eigen::Vector3d& n = c.neighbor_circumcenter[i];
+              const double rn = (n - dt.points[c.v[(i + 1) % 4]]).norm();
+              EXPECT_NEAR((n - dt.points[c.v[(i + 2) % 4]]).norm(), rn, 1e-9 * rn);
+              EXPECT_NEAR((n - dt.points[c.v[(i + 3) % 4]]).norm(), rn, 1e-9 * rn);
+            }
+          }
+        });
+    std::size_t cells = 0, hull = 0, own = 0, shared = 0;
+    for (const auto& k : count) {
+      cells += k[0];
+      hull += k[1];
+      own += k[2];
+      shared += k[3];
     }
+    // Every cell once; every interior facet visited from exactly one of its cells.
+    EXPECT_EQ(cells, dt.number_of_cells);
+    EXPECT_EQ(own, shared);
+    EXPECT_EQ(4 * cells, hull + 2 * own);
+    EXPECT_GT(hull, 0u);
   }
-  EXPECT_GT(hull_facets, 0u);
 }
 
 TEST(Triangulate, RecentresLargeCoordinates)

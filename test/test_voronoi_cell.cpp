@@ -206,7 +206,7 @@ TEST(VoronoiCells, HullPolesOfATetrahedronPointAway)
   const auto unique = makeUniquePoints(P);
   const Triangulation dt = triangulate(unique.points);
   ASSERT_EQ(dt.dimension, 3);
-  ASSERT_EQ(dt.cells.size(), 4u);
+  ASSERT_EQ(dt.number_of_cells, 4u);
   const VoronoiCells vc = computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
   for (int i = 0; i < 4; ++i) {
     const int v = unique.vertex_of_input[i];

@@ -35,14 +35,15 @@ localSpacing(const Triangulation& dt)
       list[k] = list[k - 1];
     list[k] = {d, b};
   };
-  const int corners = dt.dimension == 2 ? 3 : 4;
-  for (const auto& cell : dt.cells)
-    for (int i = 0; i < corners; ++i)
-      for (int j = i + 1; j < corners; ++j) {
-        const double d = (dt.points[cell[i]] - dt.points[cell[j]]).norm();
-        offer(cell[i], cell[j], d);
-        offer(cell[j], cell[i], d);
+  forEachCell(dt, 0, 1, [&](const CellView& cell, int) {
+    for (int i = 0; i < cell.corners; ++i)
+      for (int j = i + 1; j < cell.corners; ++j) {
+        const int a = cell.v[i], b = cell.v[j];
+        const double d = (dt.points[a] - dt.points[b]).norm();
+        offer(a, b, d);
+        offer(b, a, d);
       }
+  });
   std::vector<double> mean(n, 0.0);
   for (std::size_t v = 0; v < n; ++v) {
     int count = 0;

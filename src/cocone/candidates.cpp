@@ -31,19 +31,19 @@ selectCandidates(const VoronoiCells& cells,
   }
   if (rule == CandidateRule::LITERAL && dt && dt->dimension == 3) {
     // All-boundary triangles whose dual edge meets no co-cone.
-    for (std::size_t c = 0; c < dt->cells.size(); ++c)
+    forEachCell(*dt, CellView::FACETS, 1, [&](const CellView& cell, int) {
       for (int i = 0; i < 4; ++i) {
-        const int other = dt->neighbors[c][i];
-        if (other >= 0 && other < static_cast<int>(c))
+        if (cell.facet[i] == FacetRole::SHARED)
           continue;
         Triangle f;
         for (int k = 0, j = 0; k < 4; ++k)
           if (k != i)
-            f[j++] = dt->cells[c][k];
+            f[j++] = cell.v[k];
         std::sort(f.begin(), f.end());
         if (boundary[f[0]] && boundary[f[1]] && boundary[f[2]])
           out.push_back(f);
       }
+    });
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }

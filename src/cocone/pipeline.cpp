@@ -20,6 +20,9 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <new>
+#include <string>
+#include <system_error>
 
 namespace pcl {
 namespace cocone {
@@ -44,7 +47,7 @@ private:
 
 /** Stages 4-7 and the repair: the oriented manifold mesh over vertex ids. */
 void
-reconstruct(const Triangulation& dt,
+reconstruct(Triangulation& dt,
             const VoronoiCells& cells,
             const Parameters& parameters,
             Result& result)
@@ -53,6 +56,7 @@ reconstruct(const Triangulation& dt,
   const std::vector<Triangle> candidates =
       selectCandidates(cells, result.boundary, parameters.candidate_rule, &dt);
   counts.candidates = candidates.size();
+  dt.release(); // the cells are no longer needed: make room for stages 5-7
   const TriangleComplex complex(dt.points, candidates);
 
   std::vector<std::uint8_t> umbrella_triangles;
@@ -118,13 +122,11 @@ reconstruct(const Triangulation& dt,
   }
 }
 
-} // namespace
-
 Result
-run(const std::vector<Eigen::Vector3d>& points,
-    const Parameters& parameters,
-    Stages stages,
-    const std::vector<int>& ids)
+runStages(const std::vector<Eigen::Vector3d>& points,
+          const Parameters& parameters,
+          Stages stages,
+          const std::vector<int>& ids)
 {
   Result result;
   Stopwatch clock;
@@ -141,7 +143,7 @@ run(const std::vector<Eigen::Vector3d>& points,
     return result;
   }
 
-  const Triangulation dt = triangulate(unique.points);
+  Triangulation dt = triangulate(unique.points);
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";
@@ -168,7 +170,9 @@ run(const std::vector<Eigen::Vector3d>& points,
   result.timings.boundary = clock.lap();
 
   result.umbrella_failed.assign(result.vertices, 0);
-  if (stages == Stages::RECONSTRUCTION) {
+  if (stages != Stages::RECONSTRUCTION)
+    dt.release();
+  else {
     reconstruct(dt, cells, parameters, result);
     result.timings.reconstruction = clock.lap();
   }
@@ -195,6 +199,31 @@ run(const std::vector<Eigen::Vector3d>& points,
   }
   result.positions = dt.points;
   return result;
+}
+
+} // namespace
+
+Result
+run(const std::vector<Eigen::Vector3d>& points,
+    const Parameters& parameters,
+    Stages stages,
+    const std::vector<int>& ids)
+{
+  // Running out of memory is an outcome to report, not a reason to terminate the
+  // caller's process (a scanning pipeline keeps running with an empty result).
+  try {
+    return runStages(points, parameters, stages, ids);
+  }
+  catch (const std::bad_alloc&) {
+    Result failed;
+    failed.error = "out of memory for " + std::to_string(points.size()) + " points";
+    return failed;
+  }
+  catch (const std::system_error& e) { // no thread could be started
+    Result failed;
+    failed.error = std::string("system error: ") + e.what();
+    return failed;
+  }
 }
 
 } // namespace cocone

@@ -5,19 +5,24 @@
 
 #include <pcl/surface/cocone/triangulation.h>
 
-#include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/spatial_sort.h>
 
+#include "delaunay.h"
 #include "points.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <exception>
+#include <iterator>
 #include <limits>
+#include <new>
 #include <numeric>
+#include <thread>
 #include <utility>
 
 namespace pcl {
@@ -25,33 +30,15 @@ namespace cocone {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
-using CellBase = CGAL::Triangulation_cell_base_with_info_3<
-    int,
-    Kernel,
-    CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
-using Tds = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
-using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
-
+using detail::Delaunay;
 using detail::isFinite;
+using detail::Kernel;
 using detail::lexLess;
 
 Eigen::Vector3d
 toEigen(const CGAL::Exact_predicates_exact_constructions_kernel::Point_3& p)
 {
   return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
-}
-
-/** The cell's vertex ids sorted ascending, the canonical order for constructions. */
-template <std::size_t N>
-std::array<int, N>
-sortedIds(const std::array<int, 4>& cell)
-{
-  std::array<int, N> ids;
-  std::copy_n(cell.begin(), N, ids.begin());
-  std::sort(ids.begin(), ids.end());
-  return ids;
 }
 
 } // namespace
@@ -164,6 +151,83 @@ triangleCircumcenter(const Eigen::Vector3d& a,
   return toEigen(CGAL::circumcenter(p(a), p(b), p(c)));
 }
 
+namespace {
+
+/** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
+int
+cornersOf(const Delaunay& dt)
+{
+  return dt.dimension() == 3 ? 4 : 3;
+}
+
+bool
+isFiniteCell(const Delaunay& dt, Delaunay::Cell_handle c)
+{
+  for (int i = 0, corners = cornersOf(dt); i < corners; ++i)
+    if (dt.is_infinite(c->vertex(i)))
+      return false;
+  return true;
+}
+
+/** The circumcenter of a finite cell, from its vertices in ascending id order (a
+ * canonical order: the result is bitwise reproducible). */
+Eigen::Vector3d
+circumcenterOf(const Delaunay& dt, Delaunay::Cell_handle c)
+{
+  // The points are read from CGAL's vertices, which are loaded for their ids
+  // anyway; they hold the same recentred coordinates as Triangulation::points.
+  std::array<std::pair<int, const Kernel::Point_3*>, 4> s;
+  const int corners = cornersOf(dt);
+  for (int i = 0; i < corners; ++i)
+    s[i] = {c->vertex(i)->info(), &c->vertex(i)->point()};
+  std::sort(s.begin(), s.begin() + corners, [](const auto& a, const auto& b) {
+    return a.first < b.first;
+  });
+  const auto p = [&](int k) {
+    const Kernel::Point_3& q = *s[k].second;
+    return Eigen::Vector3d(q.x(), q.y(), q.z());
+  };
+  return corners == 4 ? tetrahedronCircumcenter(p(0), p(1), p(2), p(3))
+                      : triangleCircumcenter(p(0), p(1), p(2));
+}
+
+/** Run body(cell, thread) over the finite cells, split in equal runs per thread. */
+template <typename Body>
+void
+splitCells(const Delaunay& dt, std::size_t count, int threads, const Body& body)
+{
+  // An exception must not leave a parallel region: it is caught in the thread and
+  // thrown again after the region (only std::bad_alloc can occur here).
+  bool failed = false;
+#pragma omp parallel num_threads(threads)
+  {
+#ifdef _OPENMP
+    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
+#else
+    const int thread = 0, team = 1;
+#endif
+    const std::size_t begin = count * thread / team, end = count * (thread + 1) / team;
+    std::size_t k = 0;
+    try {
+      for (auto c = dt.tds().raw_cells_begin();
+           c != dt.tds().raw_cells_end() && k < end;
+           ++c) {
+        if (!isFiniteCell(dt, c))
+          continue;
+        if (k++ >= begin)
+          body(c, thread);
+      }
+    }
+    catch (const std::bad_alloc&) {
+      __atomic_store_n(&failed, true, __ATOMIC_RELAXED);
+    }
+  }
+  if (failed)
+    throw std::bad_alloc();
+}
+
+} // namespace
+
 Triangulation
 triangulate(const std::vector<Eigen::Vector3d>& points)
 {
@@ -186,64 +250,155 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
     const auto& p = out.points[i];
     sites.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), static_cast<int>(i));
   }
-  Delaunay dt;
-  // Range insertion spatially sorts the sites; CGAL's symbolic perturbation makes the
-  // triangulation of degenerate (co-spherical) input independent of that order.
-  dt.insert(sites.begin(), sites.end());
+  // CGAL's spatial sort (Hilbert order with random rounds, seeded) and insertion
+  // with the previous vertex as the hint: what range insertion does, minus its
+  // indirection through an index array. CGAL's symbolic perturbation makes the
+  // triangulation of degenerate (co-spherical) input independent of the order.
+  CGAL::spatial_sort(
+      sites.begin(),
+      sites.end(),
+      CGAL::Spatial_sort_traits_adapter_3<
+          Kernel,
+          CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
+  out.structure = std::make_shared<detail::DelaunayStructure>();
+  Delaunay& dt = out.structure->dt;
+  // CGAL's insertion keeps scratch tables in thread-local storage that an exception
+  // (std::bad_alloc) leaves dirty, which breaks every later insertion in the same
+  // thread. Building in a thread of its own confines that state to this call.
+  std::exception_ptr failure;
+  std::thread builder([&]() {
+    try {
+      Delaunay::Vertex_handle hint;
+      for (const auto& site : sites) {
+        hint = dt.insert(site.first, hint);
+        hint->info() = site.second;
+      }
+    }
+    catch (...) {
+      failure = std::current_exception();
+    }
+  });
+  builder.join();
+  if (failure)
+    std::rethrow_exception(failure);
+  std::vector<std::pair<Kernel::Point_3, int>>().swap(sites);
   out.dimension = dt.dimension();
+  if (out.dimension < 2) {
+    out.release();
+    return out;
+  }
 
-  if (out.dimension == 3) {
-    const std::size_t n = dt.number_of_finite_cells();
-    out.cells.reserve(n);
-    int id = 0;
-    for (auto c : dt.finite_cell_handles())
-      c->info() = id++;
-    for (auto c : dt.finite_cell_handles()) {
-      std::array<int, 4> v, nb;
-      for (int i = 0; i < 4; ++i) {
-        v[i] = c->vertex(i)->info();
-        const auto other = c->neighbor(i);
-        nb[i] = dt.is_infinite(other) ? -1 : other->info();
-      }
-      out.cells.push_back(v);
-      out.neighbors.push_back(nb);
-    }
-    dt.clear(); // release the CGAL structure before the per-cell arrays grow
-    out.circumcenters.resize(out.cells.size());
-    for (std::size_t c = 0; c < out.cells.size(); ++c) {
-      const auto s = sortedIds<4>(out.cells[c]);
-      const auto& P = out.points;
-      out.circumcenters[c] =
-          tetrahedronCircumcenter(P[s[0]], P[s[1]], P[s[2]], P[s[3]]);
-    }
-  }
-  else if (out.dimension == 2) {
-    // In dimension 2 CGAL stores each triangle as a cell with vertices 0..2; the
-    // finite facets (c, 3) enumerate them.
-    int id = 0;
-    for (auto f : dt.finite_facets())
-      f.first->info() = id++;
-    for (auto f : dt.finite_facets()) {
-      const auto c = f.first;
-      std::array<int, 4> v{-1, -1, -1, -1}, nb{-1, -1, -1, -1};
-      for (int i = 0; i < 3; ++i) {
-        v[i] = c->vertex(i)->info();
-        const auto other = c->neighbor(i);
-        nb[i] = dt.is_infinite(other) ? -1 : other->info();
-      }
-      out.cells.push_back(v);
-      out.neighbors.push_back(nb);
-    }
-    dt.clear();
-    out.circumcenters.resize(out.cells.size());
-    for (std::size_t c = 0; c < out.cells.size(); ++c) {
-      const auto s = sortedIds<3>(out.cells[c]);
-      const auto& P = out.points;
-      out.circumcenters[c] = triangleCircumcenter(P[s[0]], P[s[1]], P[s[2]]);
-    }
-  }
+  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c)
+    out.number_of_cells += isFiniteCell(dt, c);
   return out;
 }
+
+int
+resolveThreads(unsigned int requested)
+{
+#ifdef _OPENMP
+  const int available = std::max(1, omp_get_num_procs());
+#else
+  const int available = 1;
+#endif
+  return requested == 0 ? available : static_cast<int>(requested);
+}
+
+std::vector<std::array<int, 4>>
+hullFacets(const Triangulation& triangulation)
+{
+  std::vector<std::array<int, 4>> out;
+  if (!triangulation.structure || triangulation.dimension != 3)
+    return out;
+  const Delaunay& dt = triangulation.structure->dt;
+  std::vector<Delaunay::Cell_handle> outside;
+  dt.incident_cells(dt.infinite_vertex(), std::back_inserter(outside));
+  for (const auto c : outside) {
+    // The finite facet of an infinite cell, and the vertex across it.
+    const int i = c->index(dt.infinite_vertex());
+    const auto inside = c->neighbor(i);
+    const int j = inside->index(c);
+    std::array<int, 4> f;
+    for (int k = 0, m = 0; k < 4; ++k)
+      if (k != j)
+        f[m++] = inside->vertex(k)->info();
+    std::sort(f.begin(), f.begin() + 3);
+    f[3] = inside->vertex(j)->info();
+    out.push_back(f);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+namespace detail {
+
+void
+visitCells(const Triangulation& triangulation,
+           unsigned int data,
+           int threads,
+           CellVisitor visitor,
+           void* context)
+{
+  if (!triangulation.structure)
+    return;
+  const Delaunay& dt = triangulation.structure->dt;
+  const int corners = cornersOf(dt);
+  // A small direct-mapped cache of circumcenters per thread: the cells across a
+  // cell's facets were mostly created, and are visited, close to it, and computing
+  // a circumcenter again costs mainly the cache misses of loading that cell.
+  constexpr int CACHE_BITS = 14;
+  struct Entry {
+    const void* cell = nullptr;
+    Eigen::Vector3d circumcenter;
+  };
+  std::vector<std::vector<Entry>> caches(threads);
+  const auto cached = [&](std::vector<Entry>& cache, Delaunay::Cell_handle c) {
+    const auto key = reinterpret_cast<std::uintptr_t>(&*c);
+    Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
+    if (e.cell != &*c) {
+      e.cell = &*c;
+      e.circumcenter = circumcenterOf(dt, c);
+    }
+    return e.circumcenter;
+  };
+  splitCells(dt,
+             triangulation.number_of_cells,
+             threads,
+             [&](Delaunay::Cell_handle c, int thread) {
+               auto& cache = caches[thread];
+               if (cache.empty())
+                 cache.resize(std::size_t(1) << CACHE_BITS);
+               CellView view;
+               view.corners = corners;
+               view.v = {-1, -1, -1, -1};
+               for (int i = 0; i < corners; ++i)
+                 view.v[i] = c->vertex(i)->info();
+               if (data & CellView::CIRCUMCENTER)
+                 view.circumcenter = cached(cache, c);
+               for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
+                 if (i >= corners) {
+                   view.facet[i] = FacetRole::HULL;
+                   continue;
+                 }
+                 const auto other = c->neighbor(i);
+                 // Each interior facet once: from the cell at the higher address,
+                 // visited after the other one, whose circumcenter is then likely
+                 // still cached. Which cell it is does not matter to the visitors.
+                 if (!isFiniteCell(dt, other))
+                   view.facet[i] = FacetRole::HULL;
+                 else if (&*other > &*c)
+                   view.facet[i] = FacetRole::SHARED;
+                 else {
+                   view.facet[i] = FacetRole::OWN;
+                   if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS)
+                     view.neighbor_circumcenter[i] = cached(cache, other);
+                 }
+               }
+               visitor(context, view, thread);
+             });
+}
+
+} // namespace detail
 
 } // namespace cocone
 } // namespace pcl

@@ -6,9 +6,6 @@
 #include <pcl/surface/cocone/voronoi_cell.h>
 
 #include "points.h"
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include <algorithm>
 #include <cmath>
@@ -54,10 +51,29 @@ planarCells(const Triangulation& dt, double cocone_angle)
   const auto& P = dt.points;
   const std::size_t n = P.size();
   VoronoiCells vc;
-  // Plane normal from the first triangle, signed canonically for reproducibility.
-  const auto f0 = facetIds(dt.cells.front(), 3);
+  vc.on_hull.assign(n, 0);
+  std::vector<double> radius(n, 0.0);
+  std::array<int, 3> first{std::numeric_limits<int>::max(), 0, 0};
+  forEachCell(
+      dt, CellView::CIRCUMCENTER | CellView::FACETS, 1, [&](const CellView& cell, int) {
+        for (int i = 0; i < 3; ++i) {
+          const int v = cell.v[i];
+          radius[v] = std::max(radius[v], (cell.circumcenter - P[v]).norm());
+          // An outline edge: its two vertices have unbounded planar cells.
+          if (cell.facet[i] == FacetRole::HULL) {
+            vc.on_hull[cell.v[(i + 1) % 3]] = 1;
+            vc.on_hull[cell.v[(i + 2) % 3]] = 1;
+          }
+        }
+        // The dual of a planar triangle is the line through its circumcenter along the
+        // normal; it passes through the plane, where every co-cone contains it.
+        const auto f = facetIds(cell.v, 3);
+        vc.triangles.push_back({f, 7});
+        first = std::min(first, f);
+      });
+  // Plane normal from the triangle of lowest ids, signed canonically.
   Eigen::Vector3d normal =
-      (P[f0[1]] - P[f0[0]]).cross(P[f0[2]] - P[f0[0]]).normalized();
+      (P[first[1]] - P[first[0]]).cross(P[first[2]] - P[first[0]]).normalized();
   for (int k = 0; k < 3; ++k)
     if (normal[k] != 0.0) {
       if (normal[k] < 0.0)
@@ -69,27 +85,13 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.pole.assign(n, normal);
   vc.height_plus.assign(n, INF);
   vc.height_minus.assign(n, INF);
-  vc.on_hull.assign(n, 0);
-  std::vector<double> radius(n, 0.0);
-  for (std::size_t c = 0; c < dt.cells.size(); ++c) {
-    const auto& cell = dt.cells[c];
-    for (int i = 0; i < 3; ++i) {
-      const int v = cell[i];
-      radius[v] = std::max(radius[v], (dt.circumcenters[c] - P[v]).norm());
-      // An outline edge: its two vertices have unbounded planar cells.
-      if (dt.neighbors[c][i] < 0) {
-        vc.on_hull[cell[(i + 1) % 3]] = 1;
-        vc.on_hull[cell[(i + 2) % 3]] = 1;
-      }
-    }
-    // The dual of a planar triangle is the line through its circumcenter along the
-    // normal; it passes through the plane, where every co-cone contains it.
-    vc.triangles.push_back({facetIds(cell, 3), 7});
-  }
   const double s = std::sin(cocone_angle);
   vc.width.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     vc.width[v] = vc.on_hull[v] ? INF : radius[v] / s;
+  std::sort(vc.triangles.begin(),
+            vc.triangles.end(),
+            [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
   return vc;
 }
 
@@ -122,30 +124,7 @@ atomicMax(std::uint64_t* target, double x)
   }
 }
 
-/** Replace *target by x atomically if *target is -1 or less(*target, x). */
-template <typename Less>
-void
-atomicRaise(int* target, int x, const Less& less)
-{
-  int seen = __atomic_load_n(target, __ATOMIC_RELAXED);
-  while ((seen < 0 || less(seen, x)) &&
-         !__atomic_compare_exchange_n(
-             target, &seen, x, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-  }
-}
-
 } // namespace
-
-int
-resolveThreads(unsigned int requested)
-{
-#ifdef _OPENMP
-  const int available = std::max(1, omp_get_num_procs());
-#else
-  const int available = 1;
-#endif
-  return requested == 0 ? available : static_cast<int>(requested);
-}
 
 CoconeHit
 intersectCocone(const Eigen::Vector3d& p,
@@ -202,87 +181,127 @@ computeVoronoiCells(const Triangulation& dt,
                     double cocone_angle,
                     unsigned int num_threads)
 {
-  if (dt.dimension == 2 && !dt.cells.empty())
+  if (dt.dimension == 2 && dt.number_of_cells > 0)
     return planarCells(dt, cocone_angle);
   VoronoiCells vc;
   if (dt.dimension != 3)
     return vc;
 
   const auto& P = dt.points;
-  const auto& cc = dt.circumcenters;
-  const std::size_t n = P.size(), m = dt.cells.size();
+  const std::size_t n = P.size();
+  const int threads = resolveThreads(num_threads);
   vc.on_hull.assign(n, 0);
 
-  // Hull facets, summed per vertex in facet order so the sum is reproducible.
+  // Pass 1 over the cells: the positive pole, the farthest Voronoi vertex (ties
+  // broken by position, so the choice does not depend on the visiting order). With
+  // several threads a vertex's record is updated under its own spin lock.
+  std::vector<double> far2(n, -1.0);
+  std::vector<Eigen::Vector3d> far(n);
+  std::vector<std::uint8_t> lock(threads > 1 ? n : 0, 0);
+  forEachCell(dt, CellView::CIRCUMCENTER, threads, [&](const CellView& cell, int) {
+    const Eigen::Vector3d& cc = cell.circumcenter;
+    if (!isFinite(cc))
+      return;
+    for (const int v : cell.v) {
+      const double d2 = (cc - P[v]).squaredNorm();
+      if (threads > 1)
+        while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
+        }
+      if (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc))) {
+        far2[v] = d2;
+        far[v] = cc;
+      }
+      if (threads > 1)
+        __atomic_clear(&lock[v], __ATOMIC_RELEASE);
+    }
+  });
+  std::vector<std::uint8_t>().swap(lock);
+
+  // The hull facets' outward normals, summed per vertex in facet order so that the
+  // sum is reproducible.
   struct HullFacet {
     std::array<int, 3> f;
     Eigen::Vector3d normal;
   };
   std::vector<HullFacet> hull;
-  for (std::size_t c = 0; c < m; ++c)
-    for (int i = 0; i < 4; ++i)
-      if (dt.neighbors[c][i] < 0) {
-        const auto f = facetIds(dt.cells[c], i);
-        hull.push_back({f, outwardNormal(P, f, dt.cells[c][i])});
-      }
-  std::sort(hull.begin(), hull.end(), [](const HullFacet& a, const HullFacet& b) {
-    return a.f < b.f;
-  });
+  for (const auto& h : hullFacets(dt)) {
+    const std::array<int, 3> f{h[0], h[1], h[2]};
+    hull.push_back({f, outwardNormal(P, f, h[3])});
+  }
   std::vector<Eigen::Vector3d> hull_sum(n, Eigen::Vector3d::Zero());
   for (const auto& h : hull)
     for (const int v : h.f) {
       hull_sum[v] += h.normal;
       vc.on_hull[v] = 1;
     }
-
-  // The per-vertex maxima below are taken with atomic updates, so the cells can be
-  // visited in parallel: a maximum does not depend on the order of the updates.
-  const int threads = resolveThreads(num_threads);
-
-  // Positive pole: the farthest Voronoi vertex (ties broken by position).
-  std::vector<std::uint64_t> far2(n, 0); // bits of non-negative doubles
-  std::vector<int> far_cell(n, -1);
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
-    if (!isFinite(cc[c]))
-      continue;
-    for (const int v : dt.cells[c])
-      atomicMax(&far2[v], (cc[c] - P[v]).squaredNorm());
-  }
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
-    if (!isFinite(cc[c]))
-      continue;
-    for (const int v : dt.cells[c])
-      if (bitsOf((cc[c] - P[v]).squaredNorm()) == far2[v])
-        atomicRaise(&far_cell[v], static_cast<int>(c), [&](int a, int b) {
-          return lexLess(cc[a], cc[b]) || (cc[a] == cc[b] && a < b);
-        });
-  }
   vc.pole.assign(n, Eigen::Vector3d::Zero());
   vc.height_plus.assign(n, INF);
   for (std::size_t v = 0; v < n; ++v) {
-    const double d2 = doubleOf(far2[v]);
     if (vc.on_hull[v] && hull_sum[v].norm() > 0.0)
       vc.pole[v] = hull_sum[v].normalized();
-    else if (far_cell[v] >= 0 && d2 > 0.0) {
-      vc.height_plus[v] = std::sqrt(d2);
-      vc.pole[v] = (cc[far_cell[v]] - P[v]) / vc.height_plus[v];
+    else if (far2[v] > 0.0) {
+      vc.height_plus[v] = std::sqrt(far2[v]);
+      vc.pole[v] = (far[v] - P[v]) / vc.height_plus[v];
     }
   }
+  std::vector<double>().swap(far2);
+  std::vector<Eigen::Vector3d>().swap(far);
+  std::vector<Eigen::Vector3d>().swap(hull_sum);
 
-  // Negative pole: the farthest Voronoi vertex on the other side of p.
-  std::vector<std::uint64_t> neg2(n, 0);
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
-    if (!isFinite(cc[c]))
-      continue;
-    for (const int v : dt.cells[c]) {
-      const Eigen::Vector3d y = cc[c] - P[v];
-      if (y.dot(vc.pole[v]) < 0.0)
-        atomicMax(&neg2[v], y.squaredNorm());
-    }
-  }
+  // Pass 2: the negative pole (the farthest Voronoi vertex on the other side of p),
+  // then the width and the co-cone triangles over the Voronoi edges, i.e. over the
+  // Delaunay facets, each visited from one of its cells. The maxima are taken with
+  // atomic updates and each thread collects its triangles; the sort below fixes
+  // their order.
+  const double cos_angle = std::cos(cocone_angle);
+  std::vector<std::uint64_t> neg2(n, 0), width(n, 0); // bits of non-negative doubles
+  std::vector<std::uint8_t> met(n, 0);
+  std::vector<std::vector<CoconeTriangle>> found(threads);
+  forEachCell(dt,
+              CellView::CIRCUMCENTER | CellView::NEIGHBORS,
+              threads,
+              [&](const CellView& cell, int thread) {
+                const Eigen::Vector3d& cc = cell.circumcenter;
+                if (isFinite(cc))
+                  for (const int v : cell.v) {
+                    const Eigen::Vector3d y = cc - P[v];
+                    if (y.dot(vc.pole[v]) < 0.0)
+                      atomicMax(&neg2[v], y.squaredNorm());
+                  }
+                for (int i = 0; i < 4; ++i) {
+                  if (cell.facet[i] == FacetRole::SHARED)
+                    continue;
+                  const auto f = facetIds(cell.v, i);
+                  Eigen::Vector3d a = cc, d;
+                  const bool ray = cell.facet[i] == FacetRole::HULL;
+                  if (ray)
+                    d = outwardNormal(P, f, cell.v[i]);
+                  else {
+                    // Orient the segment canonically so the test is bitwise
+                    // reproducible.
+                    Eigen::Vector3d b = cell.neighbor_circumcenter[i];
+                    if (lexLess(b, a))
+                      std::swap(a, b);
+                    d = b - a;
+                  }
+                  if (!isFinite(a) || !isFinite(d))
+                    continue;
+                  std::uint8_t meets = 0;
+                  for (int k = 0; k < 3; ++k) {
+                    const int v = f[k];
+                    const CoconeHit hit =
+                        intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
+                    if (hit.meets) {
+                      meets |= static_cast<std::uint8_t>(1u << k);
+                      atomicMax(&width[v], hit.max_distance);
+                      if (!met[v])
+                        __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
+                    }
+                  }
+                  if (meets)
+                    found[thread].push_back({f, meets});
+                }
+              });
   vc.height_minus.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     vc.height_minus[v] = std::sqrt(doubleOf(neg2[v]));
@@ -292,56 +311,6 @@ computeVoronoiCells(const Triangulation& dt,
       if (h.normal.dot(vc.pole[v]) < 0.0)
         vc.height_minus[v] = INF;
 
-  // Width and the co-cone triangles: one pass over the Voronoi edges, i.e. over the
-  // Delaunay triangles, each visited from its lower-numbered cell. Each thread
-  // collects its triangles; the sort below fixes their order.
-  const double cos_angle = std::cos(cocone_angle);
-  std::vector<std::uint64_t> width(n, 0);
-  std::vector<std::uint8_t> met(n, 0);
-  std::vector<std::vector<CoconeTriangle>> found(threads);
-#pragma omp parallel num_threads(threads)
-  {
-#ifdef _OPENMP
-    auto& mine = found[omp_get_thread_num()];
-#else
-    auto& mine = found[0];
-#endif
-#pragma omp for schedule(static)
-    for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(m); ++c) {
-      for (int i = 0; i < 4; ++i) {
-        const int other = dt.neighbors[c][i];
-        if (other >= 0 && other < c)
-          continue;
-        const auto f = facetIds(dt.cells[c], i);
-        Eigen::Vector3d a = cc[c], d;
-        const bool ray = other < 0;
-        if (ray)
-          d = outwardNormal(P, f, dt.cells[c][i]);
-        else {
-          // Orient the segment canonically so the test is bitwise reproducible.
-          Eigen::Vector3d b = cc[other];
-          if (lexLess(b, a))
-            std::swap(a, b);
-          d = b - a;
-        }
-        if (!isFinite(a) || !isFinite(d))
-          continue;
-        std::uint8_t meets = 0;
-        for (int k = 0; k < 3; ++k) {
-          const int v = f[k];
-          const CoconeHit hit = intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
-          if (hit.meets) {
-            meets |= static_cast<std::uint8_t>(1u << k);
-            atomicMax(&width[v], hit.max_distance);
-            if (!met[v])
-              __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
-          }
-        }
-        if (meets)
-          mine.push_back({f, meets});
-      }
-    }
-  }
   std::size_t total = 0;
   for (const auto& t : found)
     total += t.size();
@@ -351,12 +320,9 @@ computeVoronoiCells(const Triangulation& dt,
     std::vector<CoconeTriangle>().swap(t);
   }
   vc.width.resize(n);
-  for (std::size_t v = 0; v < n; ++v)
-    vc.width[v] = met[v] ? doubleOf(width[v]) : -INF;
   // A co-cone that meets no Voronoi edge tells nothing about flatness: not flat.
-  for (auto& w : vc.width)
-    if (w < 0.0)
-      w = INF;
+  for (std::size_t v = 0; v < n; ++v)
+    vc.width[v] = met[v] ? doubleOf(width[v]) : INF;
   std::sort(vc.triangles.begin(),
             vc.triangles.end(),
             [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });

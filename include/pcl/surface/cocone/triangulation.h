@@ -9,6 +9,9 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstdint>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
 namespace pcl {
@@ -32,15 +35,22 @@ struct UniquePoints {
 UniquePoints
 makeUniquePoints(const std::vector<Eigen::Vector3d>& input);
 
-/** \brief Stage 1: the Delaunay triangulation (exact predicates) as flat arrays.
+namespace detail {
+struct DelaunayStructure;
+} // namespace detail
+
+/** \brief Stage 1: the Delaunay triangulation (exact predicates).
  *
- * Cells are indexed 0..cells.size()-1; a neighbour id of -1 means the facet
- * opposite that vertex lies on the convex hull. The circumcenters of the cells are
- * the vertices of the Voronoi diagram; each is computed once, here.
+ * The cells stay in CGAL's structure while the passes of stages 2 and 3 run over
+ * them (forEachCell()); then release() frees it. A copy into flat arrays, or a
+ * stored circumcenter per cell, would raise the peak memory of the whole pipeline
+ * by a half: irregular samples have about 19 cells per point, and CGAL's structure
+ * is the largest thing the pipeline holds. The circumcenters (the Voronoi vertices)
+ * are recomputed where a pass needs them instead, always from the vertices in
+ * ascending id order, so that every pass sees the same bits.
  *
- * When the points are coplanar (dimension 2) the "cells" are the triangles of the
- * planar Delaunay triangulation: cells[c][3] == -1, neighbors[c][i] is the triangle
- * across the edge opposite vertex i, and circumcenters lie in the plane.
+ * When the points are coplanar (dimension 2) the cells are the triangles of the
+ * planar Delaunay triangulation.
  */
 struct Triangulation {
   /** Affine dimension of the points: 3, 2 (coplanar), 1 (collinear), 0 or -1. */
@@ -49,12 +59,17 @@ struct Triangulation {
   std::vector<Eigen::Vector3d> points;
   /** The lexicographically smallest point, subtracted before triangulating. */
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  /** Vertex ids of each finite cell. */
-  std::vector<std::array<int, 4>> cells;
-  /** neighbors[c][i]: the cell sharing the facet opposite cells[c][i], or -1. */
-  std::vector<std::array<int, 4>> neighbors;
-  /** Circumcenter of each cell (a Voronoi vertex). */
-  std::vector<Eigen::Vector3d> circumcenters;
+  /** Number of finite cells (tetrahedra, or triangles in dimension 2). */
+  std::size_t number_of_cells = 0;
+  /** CGAL's triangulation with the circumcenters; null once released. */
+  std::shared_ptr<detail::DelaunayStructure> structure;
+
+  /** Free the cells (the points stay). */
+  void
+  release()
+  {
+    structure.reset();
+  }
 };
 
 /** \brief Triangulate unique points (stage 1).
@@ -64,6 +79,77 @@ struct Triangulation {
  */
 Triangulation
 triangulate(const std::vector<Eigen::Vector3d>& points);
+
+/** \brief A thread count: \a requested, or all processors for 0 (PCL's
+ * convention). */
+int
+resolveThreads(unsigned int requested);
+
+/** \brief How a cell relates to the dual Voronoi edge of one of its facets. */
+enum class FacetRole : std::uint8_t {
+  /** The facet lies on the convex hull: its dual is a ray. */
+  HULL,
+  /** This cell visits the facet: exactly one of its two cells does. */
+  OWN,
+  /** The neighbour across the facet visits it. */
+  SHARED
+};
+
+/** \brief A finite cell, as a pass over the triangulation sees it. */
+struct CellView {
+  /** Vertex ids; in dimension 2, v[3] is -1. */
+  std::array<int, 4> v;
+  /** What a pass asks forEachCell() to compute, besides the vertices and facets. */
+  enum Data : unsigned int { CIRCUMCENTER = 1, FACETS = 2, NEIGHBORS = 4 | FACETS };
+  /** The circumcenter (the cell's Voronoi vertex), if CIRCUMCENTER was asked. */
+  Eigen::Vector3d circumcenter;
+  /** The facet opposite v[i] (the edge, in dimension 2), if FACETS was asked. */
+  std::array<FacetRole, 4> facet;
+  /** For an OWN facet, the circumcenter of the cell across it, if NEIGHBORS was
+   * asked. */
+  std::array<Eigen::Vector3d, 4> neighbor_circumcenter;
+  /** Number of vertices: 4, or 3 in dimension 2. */
+  int corners;
+};
+
+/** \brief The facets on the convex hull (dimension 3): three vertex ids ascending,
+ * then the id of the vertex across the facet inside the hull; sorted. */
+std::vector<std::array<int, 4>>
+hullFacets(const Triangulation& dt);
+
+namespace detail {
+using CellVisitor = void (*)(void* context, const CellView& cell, int thread);
+void
+visitCells(const Triangulation& dt,
+           unsigned int data,
+           int threads,
+           CellVisitor visitor,
+           void* context);
+} // namespace detail
+
+/** \brief Call visit(cell, thread) once for every finite cell.
+ *
+ * The cells are split among \a threads threads (thread is 0..threads-1); the order
+ * of the calls is unspecified, so visitors must combine their results in a way that
+ * does not depend on it.
+ * \param[in] dt a triangulation not yet released
+ * \param[in] data what to compute: a combination of CellView::Data
+ * \param[in] threads number of threads (at least 1)
+ * \param[in] visit the callable
+ */
+template <typename Visit>
+void
+forEachCell(const Triangulation& dt, unsigned int data, int threads, Visit&& visit)
+{
+  detail::visitCells(
+      dt,
+      data,
+      threads,
+      [](void* context, const CellView& cell, int thread) {
+        (*static_cast<std::remove_reference_t<Visit>*>(context))(cell, thread);
+      },
+      const_cast<void*>(static_cast<const void*>(&visit)));
+}
 
 /** \brief Circumcenter of a tetrahedron, stable for nearly flat ones.
  *

@@ -102,10 +102,5 @@ computeVoronoiCells(const Triangulation& dt,
                     double cocone_angle,
                     unsigned int num_threads = 1);
 
-/** \brief A thread count: \a requested, or all processors for 0 (PCL's
- * convention). */
-int
-resolveThreads(unsigned int requested);
-
 } // namespace cocone
 } // namespace pcl
