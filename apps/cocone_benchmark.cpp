@@ -430,6 +430,8 @@ main(int argc, char** argv)
     return generate(argc, argv);
   std::string truth_kind = "auto";
   unsigned threads = 1;
+  if (method != "convert" && argc % 2 == 0)
+    return usage(argv[0]); // an option without its value
   for (int a = 3; a + 1 < argc; a += 2) {
     if (std::strcmp(argv[a], "--truth") == 0)
       truth_kind = argv[a + 1];
