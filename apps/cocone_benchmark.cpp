@@ -2,69 +2,420 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * cocone_benchmark: wall time per stage and peak memory of the pipeline next to CGAL's
- * Delaunay triangulation alone (the floor: no Delaunay-based method can be faster), on
- * seeded area-uniform random samples of a torus and of the monkey saddle.
+ * cocone_benchmark: wall time per stage, peak memory and output quality of this
+ * library next to CGAL's Delaunay triangulation alone (the floor: no Delaunay-based
+ * method can be faster) and to other reconstruction and border detection methods.
  *
- *   cocone_benchmark delaunay|pipeline|detect torus|saddle N [threads]
+ *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED]
+ *   cocone_benchmark convert CLOUD OUT.ply
+ *   cocone_benchmark METHOD CLOUD [--truth auto|closed|saddle|none] [--threads T]
  *
- * Each run measures one thing in its own process, so that the peak resident memory
- * it prints belongs to that thing; scripts/benchmark.sh runs the grid.
+ * generate writes seeded samples (area-uniform random or evenly spaced) of the torus
+ * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2; convert writes the finite
+ * points of any readable cloud; both as binary PLY of float x, y, z (what the Open3D
+ * script reads). METHOD is one of
+ *   delaunay             CGAL::Delaunay_triangulation_3 of the points
+ *   detect               this library up to the boundary detection (stages 1-3)
+ *   cocone               this library, the whole reconstruction
+ *   gp3                  pcl::GreedyProjectionTriangulation on k = 20 normals
+ *   boundary_estimation  pcl::BoundaryEstimation on k = 20 normals
+ *   advancing_front      CGAL::advancing_front_surface_reconstruction
+ * and prints one line of key=value fields: seconds, peak_mb (peak resident memory of
+ * the process) and base_mb (after reading the cloud), per stage seconds, and the
+ * output's triangles, boundary_edges (edges in one triangle) and euler (V - E + F over
+ * the vertices used), border_points, recall and precision when the truth is known.
+ * Each measurement runs in its own process so that its peak memory belongs to it;
+ * scripts/benchmark.sh runs the grid and prints the table.
+ *
+ * Border points: detect and boundary_estimation report points; of a mesh the border
+ * points are the vertices of its boundary edges. The truth (--truth):
+ *   closed  the surface has no border: every reported point is false
+ *   saddle  the monkey saddle over [-1,1]^2: points within 1.5 local spacings (mean
+ *           nearest-neighbour distance of the 10 nearest points) of the square's edge
+ *   auto    an organized PLY (a range scan): the borders of its grid, as in
+ *           cocone_scan_eval; otherwise none
+ * A reported point is correct if a true border point lies within 2 spacings, a true
+ * border point is found if a reported one lies that close (scoreBorder()).
  */
 
+#include <pcl/common/io.h>
+#include <pcl/common/point_tests.h>
+#include <pcl/features/boundary.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/search/kdtree.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/gp3.h>
+#include <pcl/point_types.h>
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "benchmark_advancing_front.h"
+#include "border_truth.h"
+#include "cloud_io.h"
+#include <support/surfaces.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <random>
+#include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
 
-/** Area-uniform random samples (rejection on the area element), seeded. */
-std::vector<Eigen::Vector3d>
-sample(const std::string& surface, std::size_t n, unsigned seed)
-{
-  std::mt19937_64 rng(seed);
-  const auto uniform = [&]() { return (rng() >> 11) * (1.0 / 9007199254740992.0); };
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(n);
-  while (points.size() < n) {
-    if (surface == "torus") {
-      const double R = 1.0, r = 0.4;
-      const double u = 2.0 * M_PI * uniform(), v = 2.0 * M_PI * uniform();
-      if (uniform() * (R + r) > R + r * std::cos(v))
-        continue;
-      points.emplace_back((R + r * std::cos(v)) * std::cos(u),
-                          (R + r * std::cos(v)) * std::sin(u),
-                          r * std::sin(v));
-    }
-    else {
-      const double x = 2.0 * uniform() - 1.0, y = 2.0 * uniform() - 1.0;
-      const double fx = 3.0 * x * x - 3.0 * y * y, fy = -6.0 * x * y;
-      if (uniform() * std::sqrt(1.0 + 72.0) > std::sqrt(1.0 + fx * fx + fy * fy))
-        continue;
-      points.emplace_back(x, y, x * x * x - 3.0 * x * y * y);
-    }
-  }
-  return points;
-}
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using pcl::cocone::Triangle;
 
 double
 peakMegabytes()
 {
   rusage usage;
   getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;
+  return usage.ru_maxrss / 1024.0; // kilobytes on Linux
+}
+
+class Stopwatch {
+public:
+  double
+  seconds() const
+  {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_)
+        .count();
+  }
+
+  /** Seconds since the previous lap (or the start). */
+  double
+  lap()
+  {
+    const double now = seconds(), since = now - last_;
+    last_ = now;
+    return since;
+  }
+
+private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  double last_ = 0.0;
+};
+
+bool
+writePly(const std::string& path, const std::vector<Eigen::Vector3d>& points)
+{
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f)
+    return false;
+  const std::uint16_t probe = 1;
+  const bool little = *reinterpret_cast<const std::uint8_t*>(&probe) == 1;
+  std::fprintf(f,
+               "ply\nformat %s 1.0\nelement vertex %zu\nproperty float x\n"
+               "property float y\nproperty float z\nend_header\n",
+               little ? "binary_little_endian" : "binary_big_endian",
+               points.size());
+  std::vector<float> xyz;
+  xyz.reserve(3 * points.size());
+  for (const auto& p : points)
+    xyz.insert(xyz.end(), {float(p.x()), float(p.y()), float(p.z())});
+  const bool ok = std::fwrite(xyz.data(), sizeof(float), xyz.size(), f) == xyz.size();
+  return std::fclose(f) == 0 && ok;
+}
+
+Cloud::Ptr
+toCloud(const std::vector<Eigen::Vector3d>& points)
+{
+  Cloud::Ptr cloud(new Cloud);
+  cloud->reserve(points.size());
+  for (const auto& p : points)
+    cloud->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  return cloud;
+}
+
+/** Read the finite points of a cloud; with \a grid, the border truth of a range grid
+ * (spacing 0 if the file is not one). */
+bool
+readPoints(const std::string& path,
+           std::vector<Eigen::Vector3d>& points,
+           cocone_app::BorderTruth* grid)
+{
+  if (grid && cocone_app::extension(path) == "ply") {
+    Cloud organized;
+    if (pcl::io::loadPLYFile(path, organized) >= 0 && organized.isOrganized()) {
+      std::vector<int> compact_of(organized.size(), -1);
+      for (std::size_t i = 0; i < organized.size(); ++i)
+        if (pcl::isFinite(organized[i])) {
+          compact_of[i] = static_cast<int>(points.size());
+          points.emplace_back(organized[i].getVector3fMap().cast<double>());
+        }
+      *grid = cocone_app::gridBorderTruth(organized, compact_of);
+      return true;
+    }
+  }
+  pcl::PCLPointCloud2 blob;
+  std::string error;
+  std::vector<Eigen::Vector3d> all;
+  if (!cocone_app::readCloud(path, blob, error) ||
+      !cocone_app::extractXYZ(blob, all, error)) {
+    std::fprintf(stderr, "%s: %s\n", path.c_str(), error.c_str());
+    return false;
+  }
+  for (const auto& p : all)
+    if (p.allFinite())
+      points.push_back(p);
+  return true;
+}
+
+/** Per point, the distance to its nearest other point. */
+std::vector<double>
+nearestDistances(const Cloud::Ptr& cloud, pcl::search::Search<pcl::PointXYZ>& tree)
+{
+  std::vector<double> d(cloud->size(), 0.0);
+  pcl::Indices k(2);
+  std::vector<float> d2(2);
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    if (tree.nearestKSearch((*cloud)[i], 2, k, d2) == 2)
+      d[i] = std::sqrt(d2[1]);
+  return d;
+}
+
+double
+mean(const std::vector<double>& v)
+{
+  double sum = 0.0;
+  for (const double x : v)
+    sum += x;
+  return v.empty() ? 0.0 : sum / double(v.size());
+}
+
+/** The monkey saddle's border: points within 1.5 local spacings of the square's
+ * edge, the local spacing being the mean nearest-neighbour distance over the 10
+ * nearest points (random samples are denser in some places than in others). */
+cocone_app::BorderTruth
+saddleTruth(const Cloud::Ptr& cloud)
+{
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  const std::vector<double> nearest = nearestDistances(cloud, tree);
+  // The edge as a polyline 1e-4 apart in x or y: at most 6e-4 in space, below the
+  // spacing of 3M samples.
+  Cloud::Ptr edge(new Cloud);
+  const int steps = 20000;
+  for (int i = 0; i <= steps; ++i) {
+    const double t = -1.0 + 2.0 * i / steps;
+    for (const double s : {-1.0, 1.0})
+      for (const auto& xy : {Eigen::Vector2d(s, t), Eigen::Vector2d(t, s)})
+        edge->push_back(pcl::PointXYZ(
+            float(xy.x()),
+            float(xy.y()),
+            float(xy.x() * xy.x() * xy.x() - 3.0 * xy.x() * xy.y() * xy.y())));
+  }
+  pcl::KdTreeFLANN<pcl::PointXYZ> edge_tree;
+  edge_tree.setInputCloud(edge);
+  cocone_app::BorderTruth truth;
+  truth.spacing = mean(nearest);
+  truth.loops = 1;
+  pcl::Indices k;
+  std::vector<float> d2;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    const int found = tree.nearestKSearch((*cloud)[i], 10, k, d2);
+    double local = 0.0;
+    for (int j = 0; j < found; ++j)
+      local += nearest[k[j]];
+    local /= std::max(found, 1);
+    pcl::Indices e(1);
+    std::vector<float> e2(1);
+    if (edge_tree.nearestKSearch((*cloud)[i], 1, e, e2) > 0 &&
+        std::sqrt(e2[0]) <= 1.5 * local)
+      truth.border.push_back(static_cast<int>(i));
+  }
+  return truth;
+}
+
+/** What a method produced. */
+struct Output {
+  bool mesh = false;
+  std::vector<Triangle> triangles;
+  std::size_t vertices = 0; ///< ids of the triangles are below this
+  bool has_border = false;
+  std::vector<int> border; ///< indices of the points
+  std::vector<std::pair<std::string, double>> stages;
+  std::string extra; ///< further key=value fields
+};
+
+/** The vertices of the edges in one triangle. */
+std::vector<int>
+meshBorder(const std::vector<Triangle>& triangles)
+{
+  const pcl::cocone::EdgeIncidences inc(triangles);
+  std::vector<int> border;
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1)
+      border.insert(border.end(), inc.edges[e].begin(), inc.edges[e].end());
+  std::sort(border.begin(), border.end());
+  border.erase(std::unique(border.begin(), border.end()), border.end());
+  return border;
+}
+
+void
+delaunayAlone(const std::vector<Eigen::Vector3d>& points, Output& out)
+{
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  Stopwatch watch;
+  std::vector<K::Point_3> p;
+  p.reserve(points.size());
+  for (const auto& q : points)
+    p.emplace_back(q.x(), q.y(), q.z());
+  CGAL::Delaunay_triangulation_3<K> dt(p.begin(), p.end());
+  out.stages.emplace_back("delaunay", watch.lap());
+  out.extra = "cells=" + std::to_string(dt.number_of_finite_cells());
+}
+
+void
+cocone(const std::vector<Eigen::Vector3d>& points,
+       bool reconstruct,
+       unsigned threads,
+       Output& out)
+{
+  pcl::cocone::Parameters parameters;
+  parameters.threads = threads;
+  const pcl::cocone::Result r =
+      pcl::cocone::run(points,
+                       parameters,
+                       reconstruct ? pcl::cocone::Stages::RECONSTRUCTION
+                                   : pcl::cocone::Stages::BOUNDARY_DETECTION);
+  const auto& t = r.timings;
+  out.stages = {{"unique", t.unique / 1e3},
+                {"delaunay", t.delaunay / 1e3},
+                {"voronoi", t.voronoi / 1e3},
+                {"boundary", t.boundary / 1e3}};
+  char extra[96];
+  std::snprintf(extra, sizeof(extra), "rho=%.2f threads=%u", r.ratio, threads);
+  out.extra = extra;
+  out.has_border = true;
+  if (!reconstruct) {
+    out.border = r.boundary_indices;
+    return;
+  }
+  out.stages.emplace_back("reconstruction", t.reconstruction / 1e3);
+  out.mesh = true;
+  out.triangles = r.polygons; // over the indices of the points, like the others'
+  out.vertices = points.size();
+  for (const auto& loop : r.border_loops)
+    out.border.insert(out.border.end(), loop.begin(), loop.end());
+  std::sort(out.border.begin(), out.border.end());
+  out.border.erase(std::unique(out.border.begin(), out.border.end()), out.border.end());
+}
+
+/** Normals from the 20 nearest points, as both PCL methods are used in practice. */
+pcl::PointCloud<pcl::Normal>::Ptr
+normals(const Cloud::Ptr& cloud, const pcl::search::KdTree<pcl::PointXYZ>::Ptr& tree)
+{
+  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+  ne.setInputCloud(cloud);
+  ne.setSearchMethod(tree);
+  ne.setKSearch(20);
+  ne.compute(*normals);
+  return normals;
+}
+
+void
+greedyProjection(const Cloud::Ptr& cloud, Output& out)
+{
+  Stopwatch watch;
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  const auto n = normals(cloud, tree);
+  out.stages.emplace_back("normals", watch.lap());
+  // The search radius scales with the sampling; the mean spacing sets it.
+  const double spacing = mean(nearestDistances(cloud, *tree));
+  out.stages.emplace_back("spacing", watch.lap());
+  pcl::PointCloud<pcl::PointNormal>::Ptr with_normals(
+      new pcl::PointCloud<pcl::PointNormal>);
+  pcl::concatenateFields(*cloud, *n, *with_normals);
+  pcl::search::KdTree<pcl::PointNormal>::Ptr tree2(
+      new pcl::search::KdTree<pcl::PointNormal>);
+  pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
+  gp3.setSearchRadius(6.0 * spacing);
+  gp3.setMu(2.5);
+  gp3.setMaximumNearestNeighbors(100);
+  gp3.setInputCloud(with_normals);
+  gp3.setSearchMethod(tree2);
+  pcl::PolygonMesh mesh;
+  gp3.reconstruct(mesh);
+  out.stages.emplace_back("triangulation", watch.lap());
+  out.mesh = true;
+  out.vertices = cloud->size();
+  for (const auto& p : mesh.polygons)
+    out.triangles.push_back(
+        {int(p.vertices[0]), int(p.vertices[1]), int(p.vertices[2])});
+  char extra[64];
+  std::snprintf(extra, sizeof(extra), "search_radius=%.6g", 6.0 * spacing);
+  out.extra = extra;
+}
+
+void
+boundaryEstimation(const Cloud::Ptr& cloud, Output& out)
+{
+  Stopwatch watch;
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  const auto n = normals(cloud, tree);
+  out.stages.emplace_back("normals", watch.lap());
+  pcl::BoundaryEstimation<pcl::PointXYZ, pcl::Normal, pcl::Boundary> be;
+  be.setInputCloud(cloud);
+  be.setInputNormals(n);
+  be.setSearchMethod(tree);
+  be.setKSearch(20);
+  be.setAngleThreshold(static_cast<float>(M_PI / 2.0));
+  pcl::PointCloud<pcl::Boundary> flags;
+  be.compute(flags);
+  out.stages.emplace_back("boundary", watch.lap());
+  out.has_border = true;
+  for (std::size_t i = 0; i < flags.size(); ++i)
+    if (flags[i].boundary_point)
+      out.border.push_back(static_cast<int>(i));
+}
+
+int
+usage(const char* program)
+{
+  std::fprintf(stderr,
+               "usage: %s generate torus|saddle random|even N OUT.ply [SEED]\n"
+               "       %s convert CLOUD OUT.ply\n"
+               "       %s delaunay|detect|cocone|gp3|boundary_estimation|"
+               "advancing_front CLOUD\n"
+               "          [--truth auto|closed|saddle|none] [--threads T]\n",
+               program,
+               program,
+               program);
+  return 1;
+}
+
+int
+generate(int argc, char** argv)
+{
+  if (argc < 6)
+    return usage(argv[0]);
+  const std::string surface = argv[2], sampling = argv[3];
+  cocone_test::SampleOptions o;
+  o.n = std::strtoul(argv[4], nullptr, 10);
+  o.seed = argc > 6 ? std::strtoull(argv[6], nullptr, 10) : 1;
+  o.even = sampling == "even";
+  if ((surface != "torus" && surface != "saddle") ||
+      (sampling != "even" && sampling != "random"))
+    return usage(argv[0]);
+  const cocone_test::Sample s =
+      surface == "torus" ? cocone_test::torus(o) : cocone_test::monkeySaddle(o);
+  if (!writePly(argv[5], s.points)) {
+    std::fprintf(stderr, "cannot write %s\n", argv[5]);
+    return 1;
+  }
+  return 0;
 }
 
 } // namespace
@@ -72,69 +423,104 @@ peakMegabytes()
 int
 main(int argc, char** argv)
 {
-  if (argc < 4) {
-    std::fprintf(
-        stderr, "usage: %s delaunay|pipeline|detect torus|saddle N [seed]\n", argv[0]);
-    return 1;
+  if (argc < 3)
+    return usage(argv[0]);
+  const std::string method = argv[1], path = argv[2];
+  if (method == "generate")
+    return generate(argc, argv);
+  std::string truth_kind = "auto";
+  unsigned threads = 1;
+  if (method != "convert" && argc % 2 == 0)
+    return usage(argv[0]); // an option without its value
+  for (int a = 3; a + 1 < argc; a += 2) {
+    if (std::strcmp(argv[a], "--truth") == 0)
+      truth_kind = argv[a + 1];
+    else if (std::strcmp(argv[a], "--threads") == 0)
+      threads = std::strtoul(argv[a + 1], nullptr, 10);
+    else
+      return usage(argv[0]);
   }
-  const std::string what = argv[1], surface = argv[2];
-  const std::size_t n = std::strtoul(argv[3], nullptr, 10);
-  const unsigned threads = argc > 4 ? std::atoi(argv[4]) : 1;
-  const auto points = sample(surface, n, 1);
-  const double base_mb = peakMegabytes();
-  const auto start = std::chrono::steady_clock::now();
-  const auto seconds = [&]() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-        .count();
-  };
 
-  if (what == "delaunay") {
-    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-    std::vector<K::Point_3> p;
-    p.reserve(points.size());
-    for (const auto& q : points)
-      p.emplace_back(q.x(), q.y(), q.z());
-    CGAL::Delaunay_triangulation_3<K> dt(p.begin(), p.end());
-    std::printf(
-        "%s %zu delaunay_alone: %.2f s, peak %.0f MB (points %.0f MB), %zu cells\n",
-        surface.c_str(),
-        n,
-        seconds(),
-        peakMegabytes(),
-        base_mb,
-        dt.number_of_finite_cells());
+  cocone_app::BorderTruth grid;
+  std::vector<Eigen::Vector3d> points;
+  if (!readPoints(path, points, truth_kind == "auto" ? &grid : nullptr))
+    return 1;
+  if (method == "convert") {
+    if (argc < 4 || !writePly(argv[3], points)) {
+      std::fprintf(stderr, "cannot write the cloud\n");
+      return 1;
+    }
     return 0;
   }
+  // The PCL methods take a PCL cloud; the others do not pay for one.
+  const bool pcl_input = method == "gp3" || method == "boundary_estimation";
+  Cloud::Ptr cloud = pcl_input ? toCloud(points) : Cloud::Ptr();
+  const double base_mb = peakMegabytes();
 
-  const auto stages = what == "detect" ? pcl::cocone::Stages::BOUNDARY_DETECTION
-                                       : pcl::cocone::Stages::RECONSTRUCTION;
-  pcl::cocone::Parameters parameters;
-  parameters.threads = threads;
-  const pcl::cocone::Result r = pcl::cocone::run(points, parameters, stages);
-  const double total = seconds();
-  const auto& t = r.timings;
-  const auto topology = pcl::cocone::analyzeMesh(r.triangles, r.vertices);
-  std::printf(
-      "%s %zu %s (%u threads): %.2f s (unique %.2f, delaunay %.2f, voronoi %.2f, "
-      "boundary "
-      "%.2f, reconstruction %.2f), peak %.0f MB; rho %.2f, %zu boundary points, "
-      "%zu triangles, %zu border loops, euler %ld, manifold %d\n",
-      surface.c_str(),
-      n,
-      what.c_str(),
-      threads,
-      total,
-      t.unique / 1e3,
-      t.delaunay / 1e3,
-      t.voronoi / 1e3,
-      t.boundary / 1e3,
-      t.reconstruction / 1e3,
-      peakMegabytes(),
-      r.ratio,
-      r.boundary_indices.size(),
-      r.triangles.size(),
-      r.border_loops.size(),
-      topology.euler,
-      int(topology.manifold()));
+  Output out;
+  Stopwatch watch;
+  if (method == "delaunay")
+    delaunayAlone(points, out);
+  else if (method == "detect" || method == "cocone")
+    cocone(points, method == "cocone", threads, out);
+  else if (method == "gp3")
+    greedyProjection(cloud, out);
+  else if (method == "boundary_estimation")
+    boundaryEstimation(cloud, out);
+  else if (method == "advancing_front") {
+    out.triangles = cocone_app::advancingFront(points);
+    out.stages.emplace_back("reconstruction", watch.seconds());
+    out.mesh = true;
+    out.vertices = points.size();
+  }
+  else
+    return usage(argv[0]);
+  const double seconds = watch.seconds();
+  const double peak_mb = peakMegabytes(); // before the evaluation adds its own
+
+  std::printf("method=%s points=%zu seconds=%.3f base_mb=%.0f peak_mb=%.0f",
+              method.c_str(),
+              points.size(),
+              seconds,
+              base_mb,
+              peak_mb);
+  std::printf(" stages=");
+  for (std::size_t i = 0; i < out.stages.size(); ++i)
+    std::printf(
+        "%s%s:%.3f", i ? "," : "", out.stages[i].first.c_str(), out.stages[i].second);
+  if (out.mesh) {
+    const auto topology = pcl::cocone::analyzeMesh(out.triangles, out.vertices);
+    std::printf(" triangles=%zu boundary_edges=%zu euler=%ld manifold=%d",
+                out.triangles.size(),
+                topology.boundary_edges,
+                topology.euler,
+                int(topology.manifold()));
+    out.has_border = true;
+    if (out.border.empty())
+      out.border = meshBorder(out.triangles);
+  }
+  if (out.has_border) {
+    std::printf(" border_points=%zu", out.border.size());
+    cocone_app::BorderTruth truth;
+    bool known = true;
+    if (truth_kind == "saddle")
+      truth = saddleTruth(toCloud(points));
+    else if (truth_kind == "auto" && grid.spacing > 0.0)
+      truth = grid;
+    else
+      known = truth_kind == "closed";
+    if (known) {
+      if (!cloud)
+        cloud = toCloud(points);
+      const auto s = cocone_app::scoreBorder(*cloud, out.border, truth);
+      if (!truth.border.empty())
+        std::printf(" recall=%.3f", s.recall);
+      if (!out.border.empty())
+        std::printf(" precision=%.3f", s.precision);
+    }
+  }
+  if (!out.extra.empty())
+    std::printf(" %s", out.extra.c_str());
+  std::printf("\n");
   return 0;
 }

@@ -23,12 +23,13 @@
 #include <pcl/features/boundary.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/io/ply_io.h>
-#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone_boundary.h>
 #include <pcl/surface/gp3.h>
 #include <pcl/point_types.h>
+
+#include "border_truth.h"
 
 #include <algorithm>
 #include <chrono>
@@ -41,130 +42,8 @@ namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
-/** Border loops of the grid with at most this many vertices (up to about two
- * missing pixels) do not count as holes. */
-constexpr std::size_t MIN_LOOP = 8;
-
-struct Truth {
-  std::vector<int> border; // indices into the compact cloud
-  std::size_t loops = 0;
-  double spacing = 0.0; // median grid edge
-};
-
-/** Triangulate the range grid and take its borders. */
-Truth
-gridTruth(const Cloud& organized, const std::vector<int>& compact_of)
-{
-  const int w = organized.width, h = organized.height;
-  const auto valid = [&](int r, int c) { return pcl::isFinite(organized(c, r)); };
-  std::vector<double> lengths;
-  for (int r = 0; r + 1 < h; ++r)
-    for (int c = 0; c + 1 < w; ++c)
-      if (valid(r, c) && valid(r, c + 1))
-        lengths.push_back(
-            (organized(c, r).getVector3fMap() - organized(c + 1, r).getVector3fMap())
-                .norm());
-  Truth truth;
-  std::nth_element(
-      lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-  truth.spacing = lengths[lengths.size() / 2];
-  const double longest = 4.0 * truth.spacing; // longer edges jump across depth gaps
-  const auto close = [&](int r0, int c0, int r1, int c1) {
-    return (organized(c0, r0).getVector3fMap() - organized(c1, r1).getVector3fMap())
-               .norm() < longest;
-  };
-  std::vector<pcl::cocone::Triangle> triangles;
-  for (int r = 0; r + 1 < h; ++r)
-    for (int c = 0; c + 1 < w; ++c) {
-      const int a[2] = {r, c}, b[2] = {r, c + 1}, d[2] = {r + 1, c},
-                e[2] = {r + 1, c + 1};
-      const auto id = [&](const int* p) { return compact_of[p[0] * w + p[1]]; };
-      const auto ok = [&](const int* p, const int* q, const int* s) {
-        return valid(p[0], p[1]) && valid(q[0], q[1]) && valid(s[0], s[1]) &&
-               close(p[0], p[1], q[0], q[1]) && close(q[0], q[1], s[0], s[1]) &&
-               close(s[0], s[1], p[0], p[1]);
-      };
-      if (ok(a, b, d))
-        triangles.push_back({id(a), id(d), id(b)});
-      if (ok(b, e, d))
-        triangles.push_back({id(b), id(d), id(e)});
-    }
-  std::size_t n = 0;
-  for (const int i : compact_of)
-    n = std::max<std::size_t>(n, i + 1);
-  // Border half-edges, traced into loops; a grid mesh can touch itself at a corner,
-  // so a vertex may start several.
-  const pcl::cocone::EdgeIncidences inc(triangles);
-  std::vector<std::vector<int>> out(n);
-  for (std::size_t e = 0; e < inc.edges.size(); ++e)
-    if (inc.count(e) == 1) {
-      const bool fwd = inc.forward[inc.first[e]];
-      out[fwd ? inc.edges[e][0] : inc.edges[e][1]].push_back(fwd ? inc.edges[e][1]
-                                                                 : inc.edges[e][0]);
-    }
-  for (std::size_t s = 0; s < n; ++s)
-    while (!out[s].empty()) {
-      std::vector<int> loop;
-      int v = static_cast<int>(s);
-      while (!out[v].empty()) {
-        loop.push_back(v);
-        const int w = out[v].back();
-        out[v].pop_back();
-        v = w;
-      }
-      // Holes of a few missing pixels are below the sampling resolution: a surface
-      // reconstruction is right to close them.
-      if (loop.size() > MIN_LOOP) {
-        ++truth.loops;
-        truth.border.insert(truth.border.end(), loop.begin(), loop.end());
-      }
-    }
-  std::sort(truth.border.begin(), truth.border.end());
-  truth.border.erase(std::unique(truth.border.begin(), truth.border.end()),
-                     truth.border.end());
-  return truth;
-}
-
-struct Score {
-  double precision = 0.0, recall = 0.0, f1 = 0.0;
-};
-
-Score
-score(const Cloud& cloud, const std::vector<int>& reported, const Truth& truth)
-{
-  const auto nearest = [&](const std::vector<int>& set) {
-    Cloud::Ptr sub(new Cloud);
-    for (const int i : set)
-      sub->push_back(cloud[i]);
-    pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-    if (!sub->empty())
-      tree.setInputCloud(sub);
-    return std::make_pair(sub, tree);
-  };
-  const double r = 2.0 * truth.spacing;
-  const auto count_close = [&](const std::vector<int>& from,
-                               const std::vector<int>& to) {
-    if (from.empty() || to.empty())
-      return std::size_t(0);
-    auto [sub, tree] = nearest(to);
-    std::size_t n = 0;
-    pcl::Indices k(1);
-    std::vector<float> d(1);
-    for (const int i : from)
-      if (tree.nearestKSearch(cloud[i], 1, k, d) > 0 && d[0] <= r * r)
-        ++n;
-    return n;
-  };
-  Score s;
-  s.precision = reported.empty() ? 0.0
-                                 : double(count_close(reported, truth.border)) /
-                                       double(reported.size());
-  s.recall = double(count_close(truth.border, reported)) / double(truth.border.size());
-  s.f1 = s.precision + s.recall > 0.0
-             ? 2.0 * s.precision * s.recall / (s.precision + s.recall)
-             : 0.0;
-  return s;
-}
+using cocone_app::BorderScore;
+using cocone_app::BorderTruth;
 
 double
 since(std::chrono::steady_clock::time_point t)
@@ -174,7 +53,7 @@ since(std::chrono::steady_clock::time_point t)
 
 void
 report(const char* method,
-       const Score& s,
+       const BorderScore& s,
        std::size_t loops,
        std::size_t points,
        double sec)
@@ -192,7 +71,7 @@ report(const char* method,
 
 void
 runCocone(const Cloud::Ptr& cloud,
-          const Truth& truth,
+          const BorderTruth& truth,
           const char* name,
           double ratio,
           double spacing_factor)
@@ -217,10 +96,14 @@ runCocone(const Cloud::Ptr& cloud,
   char label[64];
   std::snprintf(
       label, sizeof(label), "%s (rho %.2f) borders", name, cocone.getUsedRatio());
-  report(label, score(*cloud, border, truth), loops.size(), border.size(), sec);
+  report(label,
+         cocone_app::scoreBorder(*cloud, border, truth),
+         loops.size(),
+         border.size(),
+         sec);
   std::snprintf(label, sizeof(label), "%s undersampled", name);
   report(label,
-         score(*cloud, undersampled.indices, truth),
+         cocone_app::scoreBorder(*cloud, undersampled.indices, truth),
          0,
          undersampled.indices.size(),
          sec);
@@ -248,7 +131,7 @@ main(int argc, char** argv)
         compact_of[i] = static_cast<int>(cloud->size());
         cloud->push_back(organized[i]);
       }
-    const Truth truth = gridTruth(organized, compact_of);
+    const BorderTruth truth = cocone_app::gridBorderTruth(organized, compact_of);
     std::printf(
         "%s: %zu points, truth: %zu border points on %zu loops (spacing %.5f)\n",
         argv[a],
@@ -283,7 +166,7 @@ main(int argc, char** argv)
       if (flags[i].boundary_point)
         be_points.push_back(static_cast<int>(i));
     report("BoundaryEstimation points",
-           score(*cloud, be_points, truth),
+           cocone_app::scoreBorder(*cloud, be_points, truth),
            0,
            be_points.size(),
            since(t));
@@ -314,7 +197,7 @@ main(int argc, char** argv)
     gp3_border.erase(std::unique(gp3_border.begin(), gp3_border.end()),
                      gp3_border.end());
     report("GP3 (k=20 normals) borders",
-           score(*cloud, gp3_border, truth),
+           cocone_app::scoreBorder(*cloud, gp3_border, truth),
            gp3_loops.size(),
            gp3_border.size(),
            since(t));
