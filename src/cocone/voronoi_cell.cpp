@@ -145,6 +145,15 @@ intersectCocone(const Eigen::Vector3d& p,
   const double t_max = ray ? INF : 1.0;
 
   CoconeHit hit;
+  // Most Voronoi edges lie in one nappe of the double cone around the pole line, the
+  // complement of the co-cone: both ends there (for a ray, its start and its
+  // direction), on the same side of p. A nappe is convex, so the edge misses.
+  const bool start_out = C > 0.0;
+  const bool end_out = ray ? A > 0.0 : A + B + C > 0.0;
+  const double end_side = ray ? du : eu + du;
+  if (start_out && end_out && (eu > 0.0) == (end_side > 0.0) && eu != 0.0 &&
+      end_side != 0.0)
+    return hit;
   const auto consider = [&](double t) {
     if (!(t >= 0.0 && t <= t_max))
       return;
