@@ -40,14 +40,11 @@
 
 #include <pcl/common/io.h>
 #include <pcl/common/point_tests.h>
-#include <pcl/features/boundary.h>
-#include <pcl/features/normal_3d.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
-#include <pcl/surface/gp3.h>
 #include <pcl/point_types.h>
 
 #include <CGAL/Delaunay_triangulation_3.h>
@@ -56,6 +53,7 @@
 #include "benchmark_advancing_front.h"
 #include "border_truth.h"
 #include "cloud_io.h"
+#include "peer_methods.h"
 #include <support/surfaces.h>
 #include <sys/resource.h>
 
@@ -248,20 +246,6 @@ struct Output {
   std::string extra; ///< further key=value fields
 };
 
-/** The vertices of the edges in one triangle. */
-std::vector<int>
-meshBorder(const std::vector<Triangle>& triangles)
-{
-  const pcl::cocone::EdgeIncidences inc(triangles);
-  std::vector<int> border;
-  for (std::size_t e = 0; e < inc.edges.size(); ++e)
-    if (inc.count(e) == 1)
-      border.insert(border.end(), inc.edges[e].begin(), inc.edges[e].end());
-  std::sort(border.begin(), border.end());
-  border.erase(std::unique(border.begin(), border.end()), border.end());
-  return border;
-}
-
 void
 delaunayAlone(const std::vector<Eigen::Vector3d>& points, Output& out)
 {
@@ -297,65 +281,33 @@ cocone(const std::vector<Eigen::Vector3d>& points,
   char extra[96];
   std::snprintf(extra, sizeof(extra), "rho=%.2f threads=%u", r.ratio, threads);
   out.extra = extra;
-  out.has_border = true;
   if (!reconstruct) {
+    out.has_border = true;
     out.border = r.boundary_indices;
     return;
   }
   out.stages.emplace_back("reconstruction", t.reconstruction / 1e3);
-  out.mesh = true;
+  out.mesh = true; // its border points are its mesh's, as for the other meshes
   out.triangles = r.polygons; // over the indices of the points, like the others'
   out.vertices = points.size();
-  for (const auto& loop : r.border_loops)
-    out.border.insert(out.border.end(), loop.begin(), loop.end());
-  std::sort(out.border.begin(), out.border.end());
-  out.border.erase(std::unique(out.border.begin(), out.border.end()), out.border.end());
-}
-
-/** Normals from the 20 nearest points, as both PCL methods are used in practice. */
-pcl::PointCloud<pcl::Normal>::Ptr
-normals(const Cloud::Ptr& cloud, const pcl::search::KdTree<pcl::PointXYZ>::Ptr& tree)
-{
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-  ne.setInputCloud(cloud);
-  ne.setSearchMethod(tree);
-  ne.setKSearch(20);
-  ne.compute(*normals);
-  return normals;
 }
 
 void
 greedyProjection(const Cloud::Ptr& cloud, Output& out)
 {
   Stopwatch watch;
-  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
-  const auto n = normals(cloud, tree);
+  cocone_app::Tree::Ptr tree(new cocone_app::Tree);
+  const auto normals = cocone_app::estimateNormals(cloud, tree);
   out.stages.emplace_back("normals", watch.lap());
   // The search radius scales with the sampling; the mean spacing sets it.
-  const double spacing = mean(nearestDistances(cloud, *tree));
+  const double radius = 6.0 * mean(nearestDistances(cloud, *tree));
   out.stages.emplace_back("spacing", watch.lap());
-  pcl::PointCloud<pcl::PointNormal>::Ptr with_normals(
-      new pcl::PointCloud<pcl::PointNormal>);
-  pcl::concatenateFields(*cloud, *n, *with_normals);
-  pcl::search::KdTree<pcl::PointNormal>::Ptr tree2(
-      new pcl::search::KdTree<pcl::PointNormal>);
-  pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
-  gp3.setSearchRadius(6.0 * spacing);
-  gp3.setMu(2.5);
-  gp3.setMaximumNearestNeighbors(100);
-  gp3.setInputCloud(with_normals);
-  gp3.setSearchMethod(tree2);
-  pcl::PolygonMesh mesh;
-  gp3.reconstruct(mesh);
+  out.triangles = cocone_app::greedyProjection(cloud, normals, radius);
   out.stages.emplace_back("triangulation", watch.lap());
   out.mesh = true;
   out.vertices = cloud->size();
-  for (const auto& p : mesh.polygons)
-    out.triangles.push_back(
-        {int(p.vertices[0]), int(p.vertices[1]), int(p.vertices[2])});
   char extra[64];
-  std::snprintf(extra, sizeof(extra), "search_radius=%.6g", 6.0 * spacing);
+  std::snprintf(extra, sizeof(extra), "search_radius=%.6g", radius);
   out.extra = extra;
 }
 
@@ -363,22 +315,12 @@ void
 boundaryEstimation(const Cloud::Ptr& cloud, Output& out)
 {
   Stopwatch watch;
-  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
-  const auto n = normals(cloud, tree);
+  cocone_app::Tree::Ptr tree(new cocone_app::Tree);
+  const auto normals = cocone_app::estimateNormals(cloud, tree);
   out.stages.emplace_back("normals", watch.lap());
-  pcl::BoundaryEstimation<pcl::PointXYZ, pcl::Normal, pcl::Boundary> be;
-  be.setInputCloud(cloud);
-  be.setInputNormals(n);
-  be.setSearchMethod(tree);
-  be.setKSearch(20);
-  be.setAngleThreshold(static_cast<float>(M_PI / 2.0));
-  pcl::PointCloud<pcl::Boundary> flags;
-  be.compute(flags);
+  out.border = cocone_app::boundaryEstimation(cloud, normals, tree);
   out.stages.emplace_back("boundary", watch.lap());
   out.has_border = true;
-  for (std::size_t i = 0; i < flags.size(); ++i)
-    if (flags[i].boundary_point)
-      out.border.push_back(static_cast<int>(i));
 }
 
 int
@@ -496,8 +438,7 @@ main(int argc, char** argv)
                 topology.euler,
                 int(topology.manifold()));
     out.has_border = true;
-    if (out.border.empty())
-      out.border = meshBorder(out.triangles);
+    out.border = pcl::cocone::borderVertices(out.triangles);
   }
   if (out.has_border) {
     std::printf(" border_points=%zu", out.border.size());

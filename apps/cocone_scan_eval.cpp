@@ -20,16 +20,13 @@
  */
 
 #include <pcl/common/point_tests.h>
-#include <pcl/features/boundary.h>
-#include <pcl/features/normal_3d.h>
 #include <pcl/io/ply_io.h>
-#include <pcl/search/kdtree.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone_boundary.h>
-#include <pcl/surface/gp3.h>
 #include <pcl/point_types.h>
 
 #include "border_truth.h"
+#include "peer_methods.h"
 
 #include <algorithm>
 #include <chrono>
@@ -86,11 +83,10 @@ runCocone(const Cloud::Ptr& cloud,
   const double sec = since(t);
   std::vector<pcl::Vertices> loops;
   cocone.getBoundaryLoops(loops);
-  std::vector<int> border;
-  for (const auto& l : loops)
-    border.insert(border.end(), l.vertices.begin(), l.vertices.end());
-  std::sort(border.begin(), border.end());
-  border.erase(std::unique(border.begin(), border.end()), border.end());
+  std::vector<pcl::cocone::Triangle> triangles;
+  for (const auto& p : mesh.polygons)
+    triangles.push_back({int(p.vertices[0]), int(p.vertices[1]), int(p.vertices[2])});
+  const std::vector<int> border = pcl::cocone::borderVertices(triangles);
   pcl::PointIndices undersampled;
   cocone.getBoundaryPointIndices(undersampled);
   char label[64];
@@ -146,60 +142,25 @@ main(int argc, char** argv)
 
     // pcl::BoundaryEstimation with estimated normals.
     auto t = std::chrono::steady_clock::now();
-    pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(
-        new pcl::search::KdTree<pcl::PointXYZ>);
-    pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(cloud);
-    ne.setSearchMethod(tree);
-    ne.setKSearch(20);
-    ne.compute(*normals);
-    pcl::BoundaryEstimation<pcl::PointXYZ, pcl::Normal, pcl::Boundary> be;
-    be.setInputCloud(cloud);
-    be.setInputNormals(normals);
-    be.setSearchMethod(tree);
-    be.setKSearch(20);
-    pcl::PointCloud<pcl::Boundary> flags;
-    be.compute(flags);
-    std::vector<int> be_points;
-    for (std::size_t i = 0; i < flags.size(); ++i)
-      if (flags[i].boundary_point)
-        be_points.push_back(static_cast<int>(i));
+    cocone_app::Tree::Ptr tree(new cocone_app::Tree);
+    const auto normals = cocone_app::estimateNormals(cloud, tree);
+    const std::vector<int> flagged =
+        cocone_app::boundaryEstimation(cloud, normals, tree);
     report("BoundaryEstimation points",
-           cocone_app::scoreBorder(*cloud, be_points, truth),
+           cocone_app::scoreBorder(*cloud, flagged, truth),
            0,
-           be_points.size(),
+           flagged.size(),
            since(t));
 
     // Greedy projection: the borders of its mesh.
     t = std::chrono::steady_clock::now();
-    pcl::PointCloud<pcl::PointNormal>::Ptr with_normals(
-        new pcl::PointCloud<pcl::PointNormal>);
-    pcl::concatenateFields(*cloud, *normals, *with_normals);
-    pcl::search::KdTree<pcl::PointNormal>::Ptr tree2(
-        new pcl::search::KdTree<pcl::PointNormal>);
-    pcl::GreedyProjectionTriangulation<pcl::PointNormal> gp3;
-    gp3.setSearchRadius(6.0 * truth.spacing);
-    gp3.setMu(2.5);
-    gp3.setMaximumNearestNeighbors(100);
-    gp3.setInputCloud(with_normals);
-    gp3.setSearchMethod(tree2);
-    pcl::PolygonMesh gp3_mesh;
-    gp3.reconstruct(gp3_mesh);
-    std::vector<pcl::cocone::Triangle> tris;
-    for (const auto& p : gp3_mesh.polygons)
-      tris.push_back({p.vertices[0], p.vertices[1], p.vertices[2]});
-    const auto gp3_loops = pcl::cocone::boundaryLoops(tris, cloud->size());
-    std::vector<int> gp3_border;
-    for (const auto& l : gp3_loops)
-      gp3_border.insert(gp3_border.end(), l.begin(), l.end());
-    std::sort(gp3_border.begin(), gp3_border.end());
-    gp3_border.erase(std::unique(gp3_border.begin(), gp3_border.end()),
-                     gp3_border.end());
+    const auto triangles =
+        cocone_app::greedyProjection(cloud, normals, 6.0 * truth.spacing);
+    const std::vector<int> border = pcl::cocone::borderVertices(triangles);
     report("GP3 (k=20 normals) borders",
-           cocone_app::scoreBorder(*cloud, gp3_border, truth),
-           gp3_loops.size(),
-           gp3_border.size(),
+           cocone_app::scoreBorder(*cloud, border, truth),
+           pcl::cocone::boundaryLoops(triangles, cloud->size()).size(),
+           border.size(),
            since(t));
   }
   return 0;

@@ -322,11 +322,7 @@ main(int argc, char** argv)
     tris.push_back({p.vertices[0], p.vertices[1], p.vertices[2]});
   std::size_t components = 0;
   pcl::cocone::triangleComponents(tris, &components);
-  std::vector<int> border;
-  for (const auto& l : loops)
-    border.insert(border.end(), l.vertices.begin(), l.vertices.end());
-  std::sort(border.begin(), border.end());
-  border.erase(std::unique(border.begin(), border.end()), border.end());
+  const std::vector<int> border = pcl::cocone::borderVertices(tris);
   print_info("%zu triangles, %zu components, %zu border loops, %zu undersampled "
              "points.\n",
              polygons.size(),

@@ -205,7 +205,14 @@ TEST(Robustness, NearDuplicates)
   EXPECT_GT(r.triangles.size(), s.points.size());
 }
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(COCONE_SANITIZE)
+#if defined(__SANITIZE_ADDRESS__)
+#define COCONE_TEST_UNDER_ASAN
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define COCONE_TEST_UNDER_ASAN
+#endif
+#endif
+#ifndef COCONE_TEST_UNDER_ASAN
 TEST(Robustness, OutOfMemoryIsAnErrorNotATermination)
 {
   // Cap the address space a little above what the process holds: the pipeline's

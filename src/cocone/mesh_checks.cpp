@@ -214,5 +214,18 @@ boundaryLoops(const std::vector<Triangle>& oriented, std::size_t num_vertices)
   return loops;
 }
 
+std::vector<int>
+borderVertices(const std::vector<Triangle>& triangles)
+{
+  const EdgeIncidences inc(triangles);
+  std::vector<int> border;
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1)
+      border.insert(border.end(), inc.edges[e].begin(), inc.edges[e].end());
+  std::sort(border.begin(), border.end());
+  border.erase(std::unique(border.begin(), border.end()), border.end());
+  return border;
+}
+
 } // namespace cocone
 } // namespace pcl

@@ -351,7 +351,10 @@ visitCells(const Triangulation& triangulation,
     const void* cell = nullptr;
     Eigen::Vector3d circumcenter;
   };
-  std::vector<std::vector<Entry>> caches(threads);
+  std::vector<std::vector<Entry>> caches(
+      threads,
+      std::vector<Entry>(data & CellView::CIRCUMCENTER ? std::size_t(1) << CACHE_BITS
+                                                       : 0));
   const auto cached = [&](std::vector<Entry>& cache, Delaunay::Cell_handle c) {
     const auto key = reinterpret_cast<std::uintptr_t>(&*c);
     Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
@@ -366,8 +369,6 @@ visitCells(const Triangulation& triangulation,
              threads,
              [&](Delaunay::Cell_handle c, int thread) {
                auto& cache = caches[thread];
-               if (cache.empty())
-                 cache.resize(std::size_t(1) << CACHE_BITS);
                CellView view;
                view.corners = corners;
                view.v = {-1, -1, -1, -1};

@@ -151,8 +151,8 @@ intersectCocone(const Eigen::Vector3d& p,
   const bool start_out = C > 0.0;
   const bool end_out = ray ? A > 0.0 : A + B + C > 0.0;
   const double end_side = ray ? du : eu + du;
-  if (start_out && end_out && (eu > 0.0) == (end_side > 0.0) && eu != 0.0 &&
-      end_side != 0.0)
+  // (Outside the co-cone, neither eu nor end_side can be 0.)
+  if (start_out && end_out && (eu > 0.0) == (end_side > 0.0))
     return hit;
   const auto consider = [&](double t) {
     if (!(t >= 0.0 && t <= t_max))

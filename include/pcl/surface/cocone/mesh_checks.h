@@ -78,6 +78,11 @@ analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices);
 std::vector<std::vector<int>>
 boundaryLoops(const std::vector<Triangle>& oriented, std::size_t num_vertices);
 
+/** \brief The vertices of the edges that lie in exactly one triangle (the border
+ * vertices of any triangle mesh, manifold or not), ascending. */
+std::vector<int>
+borderVertices(const std::vector<Triangle>& triangles);
+
 /** \brief Component id of every triangle (through shared edges), numbered in order
  * of the lowest triangle of each component. */
 std::vector<int>
