@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <queue>
+#include <tuple>
 
 namespace pcl {
 namespace cocone {
@@ -128,36 +130,74 @@ orient(const std::vector<Eigen::Vector3d>& P,
     return false;
   };
 
-  std::vector<int> component(m, -1);
+  // Each component grows from its lowest triangle, across the edge whose two
+  // triangles, oriented alike, agree best in their normals first (Prim's order). Where
+  // the mesh cannot be oriented (a fold that a walk left near a border) the
+  // disagreement then lands on the fold's own edges, not on a seam wherever two
+  // fronts of a breadth-first pass happen to meet.
+  std::vector<Eigen::Vector3d> normal(m);
+  for (std::size_t t = 0; t < m; ++t)
+    normal[t] = unitNormal(P, triangles[t]);
+  std::vector<int> component(m, -1), order(m, -1);
   std::vector<std::uint8_t> drop(m, 0);
-  std::vector<int> queue, members;
-  int c = 0;
+  std::vector<int> members;
+  // (agreement, -triangle, -parent): the best agreement first, ties by lowest ids.
+  using Entry = std::tuple<double, int, int>;
+  std::priority_queue<Entry> heap;
+  int c = 0, rank = 0;
+  const auto offer = [&](int t) {
+    for (const int e : tri_edges[t]) {
+      if (inc.count(e) != 2)
+        continue;
+      const std::size_t i = inc.first[e];
+      const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
+      if (component[t2] >= 0)
+        continue;
+      const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
+      const double agree =
+          normal[t].dot(same ? Eigen::Vector3d(-normal[t2]) : normal[t2]);
+      heap.emplace(agree, -t2, -t);
+    }
+  };
   for (std::size_t s = 0; s < m; ++s, members.clear()) {
     if (component[s] >= 0)
       continue;
     component[s] = c;
-    queue.assign(1, static_cast<int>(s));
-    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
-      const int t = queue[qi];
-      members.push_back(t);
+    order[s] = rank++;
+    members.push_back(static_cast<int>(s));
+    offer(static_cast<int>(s));
+    while (!heap.empty()) {
+      const int t2 = -std::get<1>(heap.top()), t = -std::get<2>(heap.top());
+      heap.pop();
+      if (component[t2] >= 0)
+        continue;
+      component[t2] = c;
+      order[t2] = rank++;
+      members.push_back(t2);
+      int e = -1;
+      for (const int f : tri_edges[t2])
+        for (const int g : tri_edges[t])
+          if (f == g)
+            e = f;
+      if (traverses_forward(t, e) == traverses_forward(t2, e)) {
+        std::swap(triangles[t2][1], triangles[t2][2]);
+        normal[t2] = -normal[t2];
+        ++flipped;
+      }
+      offer(t2);
+    }
+    // A non-orientable cycle closes at an edge whose triangles still disagree: drop
+    // the one reached later (through the worse edge).
+    for (const int t : members)
       for (const int e : tri_edges[t]) {
         if (inc.count(e) != 2)
           continue;
         const std::size_t i = inc.first[e];
         const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
-        const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
-        if (component[t2] < 0) {
-          component[t2] = c;
-          if (same) {
-            std::swap(triangles[t2][1], triangles[t2][2]);
-            ++flipped;
-          }
-          queue.push_back(t2);
-        }
-        else if (same && !drop[t] && !drop[t2])
-          drop[std::max(t, t2)] = 1; // a non-orientable cycle closes here
+        if (t2 < t && traverses_forward(t, e) == traverses_forward(t2, e) && !drop[t] &&
+            !drop[t2])
+          drop[order[t] > order[t2] ? t : t2] = 1;
       }
-    }
     // Turn the component so that its signed volume about its centroid is positive.
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     for (const int t : members)

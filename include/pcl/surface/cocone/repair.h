@@ -41,9 +41,11 @@ struct RepairCounts {
  * triangle reached through another edge gives a third triangle, and triangles of
  * opposite orientation. At an edge with more than two triangles the consistently
  * oriented pair whose normals agree best is kept; at a vertex with several fans the
- * largest fan is kept; each component is then oriented by a breadth-first pass, and
- * turned so that its signed volume about its centroid is positive (closed
- * components face outward). Repeats until nothing changes.
+ * largest fan is kept; each component is then oriented from its first triangle
+ * across the edges whose triangles agree best in their normals first (so that a
+ * non-orientable fold is cut at the fold, by dropping a triangle there), and turned
+ * so that its signed volume about its centroid is positive (closed components face
+ * outward). Repeats until nothing changes.
  *
  * \param[in] points vertex positions
  * \param[in,out] triangles oriented triangles
