@@ -47,11 +47,12 @@ void
 reconstruct(const Triangulation& dt,
             const VoronoiCells& cells,
             const Parameters& parameters,
+            const std::vector<double>& rim_reach,
             Result& result)
 {
   auto& counts = result.counts;
-  const std::vector<Triangle> candidates =
-      selectCandidates(cells, result.boundary, parameters.candidate_rule, &dt);
+  const std::vector<Triangle> candidates = selectCandidates(
+      cells, result.boundary, parameters.candidate_rule, &dt, rim_reach);
   counts.candidates = candidates.size();
   const TriangleComplex complex(dt.points, candidates);
 
@@ -75,16 +76,17 @@ reconstruct(const Triangulation& dt,
 
   result.triangles = std::move(walked.triangles);
   repairManifold(dt.points, result.triangles, counts.repair);
-  if (parameters.fill_triangle_holes) {
+  if (parameters.fill_hole_edges >= 3) {
     std::vector<Triangle> delaunay;
     delaunay.reserve(cells.triangles.size());
     for (const auto& t : cells.triangles)
       delaunay.push_back(t.v);
     counts.repair.filled =
-        fillTriangleHoles(result.triangles, dt.points.size(), delaunay);
+        fillHoles(dt.points, result.triangles, delaunay, parameters.fill_hole_edges);
     if (counts.repair.filled)
       repairManifold(dt.points, result.triangles, counts.repair);
   }
+  counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size());
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   std::sort(result.triangles.begin(), result.triangles.end(), [](auto a, auto b) {
     std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
@@ -154,9 +156,13 @@ run(const std::vector<Eigen::Vector3d>& points,
   result.timings.voronoi = clock.lap();
 
   result.boundary.assign(result.vertices, 0);
+  // Per rim vertex the longest edge of the triangles it chooses; empty if none.
+  std::vector<double> rim_reach;
   if (parameters.boundary_detection) {
-    const std::vector<double> spacing =
-        parameters.spacing_factor > 0.0 ? localSpacing(dt) : std::vector<double>();
+    const bool half_disk = parameters.gap_angle > 0.0;
+    const std::vector<double> spacing = parameters.spacing_factor > 0.0 || half_disk
+                                            ? localSpacing(dt)
+                                            : std::vector<double>();
     const BoundaryLabels labels = detectBoundary(
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
@@ -164,12 +170,22 @@ run(const std::vector<Eigen::Vector3d>& points,
     result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];
+    if (half_disk) {
+      const HalfDisk test =
+          halfDiskTest(dt, cells, spacing, parameters.gap_reach, parameters.gap_angle);
+      rim_reach.assign(result.vertices, std::numeric_limits<double>::infinity());
+      for (std::size_t v = 0; v < result.vertices; ++v)
+        if (!result.boundary[v] && test.rim[v]) {
+          result.boundary[v] = 1;
+          rim_reach[v] = spacing[v];
+        }
+    }
   }
   result.timings.boundary = clock.lap();
 
   result.umbrella_failed.assign(result.vertices, 0);
   if (stages == Stages::RECONSTRUCTION) {
-    reconstruct(dt, cells, parameters, result);
+    reconstruct(dt, cells, parameters, rim_reach, result);
     result.timings.reconstruction = clock.lap();
   }
 

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <limits>
 #include <queue>
 #include <tuple>
 
@@ -241,10 +242,12 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
 }
 
 std::size_t
-fillTriangleHoles(std::vector<Triangle>& triangles,
-                  std::size_t num_vertices,
-                  const std::vector<Triangle>& allowed)
+fillHoles(const std::vector<Eigen::Vector3d>& points,
+          std::vector<Triangle>& triangles,
+          const std::vector<Triangle>& allowed,
+          std::size_t max_edges)
 {
+  const std::size_t num_vertices = points.size();
   const EdgeIncidences inc(triangles);
   // Hole half-edges run against the border half-edges of the triangles.
   std::vector<int> hole_next(num_vertices, -1);
@@ -264,25 +267,100 @@ fillTriangleHoles(std::vector<Triangle>& triangles,
     present.push_back(t);
   }
   std::sort(present.begin(), present.end());
+  const auto is_edge = [&](int a, int b) {
+    return std::binary_search(inc.edges.begin(),
+                              inc.edges.end(),
+                              std::array<int, 2>{std::min(a, b), std::max(a, b)});
+  };
   std::sort(starts.begin(), starts.end());
+  std::vector<std::uint8_t> done(num_vertices, 0);
+  std::vector<int> loop;
   std::size_t added = 0;
   for (const int x : starts) {
-    const int y = hole_next[x];
-    if (y < 0)
+    if (done[x])
       continue;
-    const int z = hole_next[y];
-    if (z < 0 || z == x || hole_next[z] != x)
+    loop.clear();
+    for (int v = x; v >= 0 && !done[v]; v = hole_next[v]) {
+      done[v] = 1;
+      loop.push_back(v);
+    }
+    const std::size_t k = loop.size();
+    if (k < 3 || k > max_edges || hole_next[loop.back()] != x)
       continue;
-    Triangle key{x, y, z};
-    std::sort(key.begin(), key.end());
-    if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
-        std::binary_search(present.begin(), present.end(), key))
+    // The triangulation of the hole's polygon by allowed triangles with the least
+    // total perimeter (dynamic programming over the polygon); no new edge may
+    // already be in the mesh.
+    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
+      Triangle key{loop[i], loop[m], loop[j]};
+      std::sort(key.begin(), key.end());
+      if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
+          std::binary_search(present.begin(), present.end(), key))
+        return false;
+      const auto diagonal = [&](std::size_t a, std::size_t b) {
+        return b - a >= 2 && !(a == 0 && b == k - 1);
+      };
+      return !(diagonal(i, m) && is_edge(loop[i], loop[m])) &&
+             !(diagonal(m, j) && is_edge(loop[m], loop[j])) &&
+             !(diagonal(i, j) && is_edge(loop[i], loop[j]));
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> cost(k * k, inf);
+    std::vector<int> split(k * k, -1);
+    for (std::size_t i = 0; i + 1 < k; ++i)
+      cost[i * k + i + 1] = 0.0;
+    for (std::size_t len = 2; len < k; ++len)
+      for (std::size_t i = 0; i + len < k; ++i) {
+        const std::size_t j = i + len;
+        for (std::size_t m = i + 1; m < j; ++m) {
+          const double c = cost[i * k + m] + cost[m * k + j];
+          if (!(c < inf) || !valid(i, m, j))
+            continue;
+          const Eigen::Vector3d &a = points[loop[i]], &b = points[loop[m]],
+                                &d = points[loop[j]];
+          const double w = c + (a - b).norm() + (b - d).norm() + (d - a).norm();
+          if (w < cost[i * k + j]) {
+            cost[i * k + j] = w;
+            split[i * k + j] = static_cast<int>(m);
+          }
+        }
+      }
+    if (!(cost[k - 1] < inf))
       continue;
-    triangles.push_back({x, y, z});
-    hole_next[x] = hole_next[y] = hole_next[z] = -1;
-    ++added;
+    std::vector<std::array<std::size_t, 2>> stack{{0, k - 1}};
+    while (!stack.empty()) {
+      const auto [i, j] = stack.back();
+      stack.pop_back();
+      if (j - i < 2)
+        continue;
+      const std::size_t m = split[i * k + j];
+      triangles.push_back({loop[i], loop[m], loop[j]});
+      ++added;
+      stack.push_back({i, m});
+      stack.push_back({m, j});
+    }
   }
   return added;
+}
+
+std::size_t
+dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  std::size_t count = 0;
+  const std::vector<int> component = triangleComponents(triangles, &count);
+  const EdgeIncidences inc(triangles);
+  std::vector<std::uint8_t> on_border(num_vertices, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1)
+      on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] = 1;
+  std::vector<std::uint8_t> inner(count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int v : triangles[t])
+      if (!on_border[v])
+        inner[component[t]] = 1;
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    drop[t] = !inner[component[t]];
+  return compact(triangles, drop);
 }
 
 } // namespace cocone
