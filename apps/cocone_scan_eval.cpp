@@ -7,7 +7,8 @@
  * pixels whose 3D edges are short form triangles, and that mesh's borders (outline
  * and occlusion holes) are the truth. Each scan is then treated as an unorganized
  * cloud and given to
- *  - this library at its default, at the paper's rho = 1.5 and at rho = 2.5;
+ *  - this library at its default, and with the paper's test (no spacing and no
+ *    half-disk test) at rho = 1.5 and at rho = 2.5;
  *  - pcl::BoundaryEstimation (normals from 20 neighbours, 20 neighbours, pi/2);
  *  - pcl::GreedyProjectionTriangulation (the borders of its mesh).
  *
@@ -71,13 +72,15 @@ runCocone(const Cloud::Ptr& cloud,
           const BorderTruth& truth,
           const char* name,
           double ratio,
-          double spacing_factor)
+          double spacing_factor,
+          double gap_angle)
 {
   const auto t = std::chrono::steady_clock::now();
   pcl::CoConeBoundary<pcl::PointXYZ> cocone;
   cocone.setInputCloud(cloud);
   cocone.setRatio(ratio);
   cocone.setSpacingFactor(spacing_factor);
+  cocone.setGapAngle(gap_angle);
   pcl::PolygonMesh mesh;
   cocone.reconstruct(mesh);
   const double sec = since(t);
@@ -136,9 +139,10 @@ main(int argc, char** argv)
         truth.loops,
         truth.spacing);
 
-    runCocone(cloud, truth, "cocone default", 0.0, 3.0);
-    runCocone(cloud, truth, "cocone paper", 1.5, 0.0);
-    runCocone(cloud, truth, "cocone paper", 2.5, 0.0);
+    const pcl::cocone::Parameters defaults;
+    runCocone(cloud, truth, "cocone default", 0.0, 3.0, defaults.gap_angle);
+    runCocone(cloud, truth, "cocone paper", 1.5, 0.0, 0.0);
+    runCocone(cloud, truth, "cocone paper", 2.5, 0.0, 0.0);
 
     // pcl::BoundaryEstimation with estimated normals.
     auto t = std::chrono::steady_clock::now();

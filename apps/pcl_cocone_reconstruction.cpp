@@ -36,6 +36,7 @@ struct Options {
   std::string input, output;
   double ratio = 0.0; // automatic
   double spacing_factor = 3.0;
+  double gap_angle = pcl::cocone::Parameters().gap_angle;
   double normal_angle = M_PI / 6.0;
   double cocone_angle = 3.0 * M_PI / 8.0;
   bool boundary_detection = true;
@@ -60,7 +61,10 @@ printHelp(const char* name)
       "the\n"
       "                    cloud; the paper uses 1.5; larger marks more points\n"
       "  -spacing_factor A undersampled if the Voronoi cell is wider than A local\n"
-      "                    spacings (default 3; 0 = the paper's test alone)\n"
+      "                    spacings (default 3; 0 = off)\n"
+      "  -gap_angle G      rim point if its neighbours leave an angular gap above G\n"
+      "                    radians (default 80 degrees; 0 = off; -spacing_factor 0\n"
+      "                    -gap_angle 0 = the paper's test alone)\n"
       "  -theta T          normal angle in radians (default pi/6)\n"
       "  -cocone_angle A   co-cone angle in radians (default 3pi/8)\n"
       "  -no_boundary      plain Co-cone, no boundary detection\n"
@@ -109,6 +113,7 @@ parseOptions(int argc, char** argv)
   // Options that take a value; everything else starting with '-' is a switch.
   const char* with_value[] = {"-rho",
                               "-spacing_factor",
+                              "-gap_angle",
                               "-theta",
                               "-cocone_angle",
                               "-threads",
@@ -145,6 +150,9 @@ parseOptions(int argc, char** argv)
   o.spacing_factor = parseNumber(argc, argv, "-spacing_factor", o.spacing_factor);
   if (!(o.spacing_factor >= 0.0))
     fail("-spacing_factor must be >= 0");
+  o.gap_angle = parseNumber(argc, argv, "-gap_angle", o.gap_angle);
+  if (!(o.gap_angle >= 0.0 && o.gap_angle < M_PI))
+    fail("-gap_angle must be in [0, pi)");
   o.normal_angle = parseNumber(argc, argv, "-theta", o.normal_angle);
   if (!(o.normal_angle > 0.0 && o.normal_angle <= M_PI / 2.0))
     fail("-theta must be in (0, pi/2]");
@@ -271,6 +279,7 @@ main(int argc, char** argv)
   cocone.setInputCloud(cloud);
   cocone.setRatio(o.ratio);
   cocone.setSpacingFactor(o.spacing_factor);
+  cocone.setGapAngle(o.gap_angle);
   cocone.setNormalAngle(o.normal_angle);
   cocone.setCoconeAngle(o.cocone_angle);
   cocone.setBoundaryDetection(o.boundary_detection);
@@ -376,7 +385,7 @@ main(int argc, char** argv)
       << ",\n  \"finite_points\": " << finite
       << ",\n  \"unique_points\": " << cocone.getNumberOfUniquePoints()
       << ",\n  \"parameters\": {\"ratio\": " << cocone.getUsedRatio()
-      << ", \"normal_angle\": " << o.normal_angle
+      << ", \"gap_angle\": " << o.gap_angle << ", \"normal_angle\": " << o.normal_angle
       << ", \"cocone_angle\": " << o.cocone_angle
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
       << ", \"threads\": " << o.threads << "},\n  \"triangles\": " << polygons.size()

@@ -2,7 +2,7 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * The default (automatic) mode on holed, noisy, uneven and anisotropic samples.
+ * The default (automatic) mode on holed, slit, noisy, uneven and anisotropic samples.
  */
 
 #include <pcl/surface/cocone/mesh_checks.h>
@@ -14,7 +14,10 @@
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 using cocone_test::options;
 using cocone_test::Sample;
@@ -100,5 +103,63 @@ TEST(AutomaticMode, AnisotropicSampling)
   for (const double ratio : {1.0, 4.0}) {
     const auto s = cocone_test::scanLineSheet(options(10000, 0.0, ratio));
     expectExact(s, reconstruct(s, ratio > 1.0 ? "density 1:4" : "clean"));
+  }
+}
+
+TEST(AutomaticMode, NarrowSlit)
+{
+  // A slit three spacings wide and 0.8 long cut out of the curved sheet. A rim
+  // point's Voronoi cell ends halfway across the slit, no wider than inside the
+  // sheet: the ratio and spacing tests pass it and the slit is covered. Seen along
+  // its pole line the rim point has its neighbours on one side: the half-disk test.
+  const auto sheet = cocone_test::curvedSheet(options(10000));
+  const double half = 1.5 * sheet.spacing, length = 0.4;
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& p : sheet.points)
+    if (!(std::abs(p.y()) < half && std::abs(p.x()) < length))
+      points.push_back(p);
+  std::vector<int> rim; // within 0.7 spacings of a long side of the slit
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (std::abs(points[i].x()) < length - sheet.spacing &&
+        std::abs(points[i].y()) < half + 0.7 * sheet.spacing)
+      rim.push_back(static_cast<int>(i));
+
+  const auto run = [&](double gap_angle) {
+    pcl::cocone::Parameters parameters;
+    parameters.gap_angle = gap_angle;
+    return pcl::cocone::run(points, parameters, pcl::cocone::Stages::RECONSTRUCTION);
+  };
+  const pcl::cocone::Result result = run(pcl::cocone::Parameters().gap_angle);
+  const auto topology = pcl::cocone::analyzeMesh(result.triangles, result.vertices);
+  std::size_t found = 0;
+  for (const int i : rim)
+    found += std::binary_search(
+        result.boundary_indices.begin(), result.boundary_indices.end(), i);
+  std::printf("[ measured ] curved sheet, slit of 3 spacings: loops %zu euler %ld "
+              "components %zu; slit rim points reported %zu of %zu\n",
+              result.border_loops.size(),
+              topology.euler,
+              topology.components,
+              found,
+              rim.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(result.border_loops.size(), 2u);
+  EXPECT_EQ(topology.euler, 0);
+  EXPECT_EQ(topology.components, 1u);
+  EXPECT_GE(double(found), 0.9 * double(rim.size()));
+  // Without the half-disk test the slit is covered.
+  const pcl::cocone::Result covered = run(0.0);
+  EXPECT_EQ(covered.border_loops.size(), 1u);
+}
+
+TEST(AutomaticMode, RandomSamplesHaveNoRims)
+{
+  // Area-uniform random samples have voids of a few spacings everywhere: the
+  // half-disk test raises its angle with the median gap and reports none of them.
+  for (const auto& s : {cocone_test::sphere(options(8000, 0.0, 1.0, false)),
+                        cocone_test::torus(options(10000, 0.0, 1.0, false))}) {
+    const Outcome o = reconstruct(s, "random");
+    EXPECT_EQ(o.mesh.loops, 0u) << s.name;
+    EXPECT_EQ(o.result.boundary_indices.size(), 0u) << s.name;
   }
 }

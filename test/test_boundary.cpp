@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 using namespace pcl::cocone;
 
@@ -98,4 +99,45 @@ TEST(DetectBoundary, PoleLinesNotVectors)
   vc.pole[3] = -tilted(0);
   vc.triangles.push_back({{0, 2, 3}, 0b001});
   EXPECT_TRUE(detectBoundary(vc, {1.5, M_PI / 6}).flat[3]);
+}
+
+TEST(HalfDiskTest, GridBorderAndInterior)
+{
+  // A 20 x 20 range-grid-like sheet, slightly curved so that the triangulation is
+  // three-dimensional and the poles follow the normal (+z): the outermost rows and
+  // columns have their neighbours on one side, the points inside all around.
+  const int n = 20;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double x = i + 0.01 * std::sin(7.0 * i + 3.0 * j),
+                   y = j + 0.01 * std::cos(5.0 * i + 11.0 * j);
+      points.emplace_back(x, y, 0.002 * (x * x + y * y));
+    }
+  const UniquePoints unique = makeUniquePoints(points);
+  const Triangulation dt = triangulate(unique.points);
+  ASSERT_EQ(dt.dimension, 3);
+  const VoronoiCells cells = computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
+  const DelaunayGraph graph = delaunayGraph(dt, 2);
+  const HalfDisk h = halfDiskTest(dt.points,
+                                  graph,
+                                  cells,
+                                  localSpacing(dt.points, graph),
+                                  1.75,
+                                  80.0 * M_PI / 180.0);
+  std::size_t border = 0, border_rim = 0, inside_rim = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int v = unique.vertex_of_input[i * n + j];
+      const bool outer = i == 0 || j == 0 || i == n - 1 || j == n - 1;
+      border += outer;
+      border_rim += outer && h.rim[v];
+      inside_rim += !outer && h.rim[v];
+      if (outer) { // a half plane, up to the jitter
+        EXPECT_GT(h.gap[v], 0.95 * M_PI) << i << " " << j;
+      }
+    }
+  EXPECT_EQ(border_rim, border);
+  EXPECT_EQ(inside_rim, 0u);
+  EXPECT_NEAR(h.angle, 80.0 * M_PI / 180.0, 1e-12);
 }

@@ -6,6 +6,7 @@
 #include <pcl/surface/cocone/candidates.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace pcl {
 namespace cocone {
@@ -14,8 +15,21 @@ std::vector<Triangle>
 selectCandidates(const VoronoiCells& cells,
                  const std::vector<std::uint8_t>& boundary,
                  CandidateRule rule,
-                 const Triangulation* dt)
+                 const Triangulation* dt,
+                 const std::vector<double>& rim_reach)
 {
+  const bool rims = dt && rim_reach.size() == dt->points.size();
+  // A rim vertex chooses a triangle when its co-cone meets the dual edge and the
+  // triangle's edges at it are within its reach: its half of a disk.
+  const auto rim_chooses = [&](const CoconeTriangle& t, int k) {
+    const double r = rim_reach[t.v[k]];
+    if (!(t.meets & (1u << k)))
+      return false;
+    for (int j = 1; j < 3; ++j)
+      if ((dt->points[t.v[(k + j) % 3]] - dt->points[t.v[k]]).squaredNorm() > r * r)
+        return false;
+    return true;
+  };
   std::vector<Triangle> out;
   // A triangle none of whose vertices' co-cones meet its dual edge is not in
   // cells.triangles; it can only be chosen by nobody.
@@ -26,6 +40,19 @@ selectCandidates(const VoronoiCells& cells,
         any_interior = true;
         chosen = chosen && (t.meets & (1u << k));
       }
+    // Where no interior vertex chooses, at a border band more than one vertex wide,
+    // the rim vertices do; undersampled vertices never choose.
+    if (!any_interior && rims && rule == CandidateRule::INTERIOR_CHOOSES) {
+      bool any_rim = false;
+      for (int k = 0; k < 3 && chosen; ++k)
+        if (std::isfinite(rim_reach[t.v[k]])) {
+          any_rim = true;
+          chosen = rim_chooses(t, k);
+        }
+      if (any_rim && chosen)
+        out.push_back(t.v);
+      continue;
+    }
     if (chosen && (any_interior || rule == CandidateRule::LITERAL))
       out.push_back(t.v);
   }

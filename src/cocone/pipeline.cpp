@@ -50,11 +50,12 @@ void
 reconstruct(Triangulation& dt,
             const VoronoiCells& cells,
             const Parameters& parameters,
+            const std::vector<double>& rim_reach,
             Result& result)
 {
   auto& counts = result.counts;
-  const std::vector<Triangle> candidates =
-      selectCandidates(cells, result.boundary, parameters.candidate_rule, &dt);
+  const std::vector<Triangle> candidates = selectCandidates(
+      cells, result.boundary, parameters.candidate_rule, &dt, rim_reach);
   counts.candidates = candidates.size();
   dt.release(); // the cells are no longer needed: make room for stages 5-7
   const TriangleComplex complex(dt.points, candidates);
@@ -79,16 +80,17 @@ reconstruct(Triangulation& dt,
 
   result.triangles = std::move(walked.triangles);
   repairManifold(dt.points, result.triangles, counts.repair);
-  if (parameters.fill_triangle_holes) {
+  if (parameters.fill_hole_edges >= 3) {
     std::vector<Triangle> delaunay;
     delaunay.reserve(cells.triangles.size());
     for (const auto& t : cells.triangles)
       delaunay.push_back(t.v);
     counts.repair.filled =
-        fillTriangleHoles(result.triangles, dt.points.size(), delaunay);
+        fillHoles(dt.points, result.triangles, delaunay, parameters.fill_hole_edges);
     if (counts.repair.filled)
       repairManifold(dt.points, result.triangles, counts.repair);
   }
+  counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size());
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   std::sort(result.triangles.begin(), result.triangles.end(), [](auto a, auto b) {
     std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
@@ -156,9 +158,16 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   result.timings.voronoi = clock.lap();
 
   result.boundary.assign(result.vertices, 0);
+  // Per rim vertex the longest edge of the triangles it chooses; empty if none.
+  std::vector<double> rim_reach;
   if (parameters.boundary_detection) {
-    const std::vector<double> spacing =
-        parameters.spacing_factor > 0.0 ? localSpacing(dt) : std::vector<double>();
+    const bool half_disk = parameters.gap_angle > 0.0;
+    std::vector<double> spacing;
+    DelaunayGraph graph;
+    if (parameters.spacing_factor > 0.0 || half_disk) {
+      graph = delaunayGraph(dt, resolveThreads(parameters.threads));
+      spacing = localSpacing(dt.points, graph);
+    }
     const BoundaryLabels labels = detectBoundary(
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
@@ -166,6 +175,21 @@ runStages(const std::vector<Eigen::Vector3d>& points,
     result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];
+    if (half_disk) {
+      const HalfDisk test = halfDiskTest(dt.points,
+                                         graph,
+                                         cells,
+                                         spacing,
+                                         parameters.gap_reach,
+                                         parameters.gap_angle,
+                                         resolveThreads(parameters.threads));
+      rim_reach.assign(result.vertices, std::numeric_limits<double>::infinity());
+      for (std::size_t v = 0; v < result.vertices; ++v)
+        if (!result.boundary[v] && test.rim[v]) {
+          result.boundary[v] = 1;
+          rim_reach[v] = spacing[v];
+        }
+    }
   }
   result.timings.boundary = clock.lap();
 
@@ -173,7 +197,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   if (stages != Stages::RECONSTRUCTION)
     dt.release();
   else {
-    reconstruct(dt, cells, parameters, result);
+    reconstruct(dt, cells, parameters, rim_reach, result);
     result.timings.reconstruction = clock.lap();
   }
 

@@ -9,6 +9,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <limits>
+#include <queue>
+#include <tuple>
 
 namespace pcl {
 namespace cocone {
@@ -128,36 +131,74 @@ orient(const std::vector<Eigen::Vector3d>& P,
     return false;
   };
 
-  std::vector<int> component(m, -1);
+  // Each component grows from its lowest triangle, across the edge whose two
+  // triangles, oriented alike, agree best in their normals first (Prim's order). Where
+  // the mesh cannot be oriented (a fold that a walk left near a border) the
+  // disagreement then lands on the fold's own edges, not on a seam wherever two
+  // fronts of a breadth-first pass happen to meet.
+  std::vector<Eigen::Vector3d> normal(m);
+  for (std::size_t t = 0; t < m; ++t)
+    normal[t] = unitNormal(P, triangles[t]);
+  std::vector<int> component(m, -1), order(m, -1);
   std::vector<std::uint8_t> drop(m, 0);
-  std::vector<int> queue, members;
-  int c = 0;
+  std::vector<int> members;
+  // (agreement, -triangle, -parent): the best agreement first, ties by lowest ids.
+  using Entry = std::tuple<double, int, int>;
+  std::priority_queue<Entry> heap;
+  int c = 0, rank = 0;
+  const auto offer = [&](int t) {
+    for (const int e : tri_edges[t]) {
+      if (inc.count(e) != 2)
+        continue;
+      const std::size_t i = inc.first[e];
+      const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
+      if (component[t2] >= 0)
+        continue;
+      const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
+      const double agree =
+          normal[t].dot(same ? Eigen::Vector3d(-normal[t2]) : normal[t2]);
+      heap.emplace(agree, -t2, -t);
+    }
+  };
   for (std::size_t s = 0; s < m; ++s, members.clear()) {
     if (component[s] >= 0)
       continue;
     component[s] = c;
-    queue.assign(1, static_cast<int>(s));
-    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
-      const int t = queue[qi];
-      members.push_back(t);
+    order[s] = rank++;
+    members.push_back(static_cast<int>(s));
+    offer(static_cast<int>(s));
+    while (!heap.empty()) {
+      const int t2 = -std::get<1>(heap.top()), t = -std::get<2>(heap.top());
+      heap.pop();
+      if (component[t2] >= 0)
+        continue;
+      component[t2] = c;
+      order[t2] = rank++;
+      members.push_back(t2);
+      int e = -1;
+      for (const int f : tri_edges[t2])
+        for (const int g : tri_edges[t])
+          if (f == g)
+            e = f;
+      if (traverses_forward(t, e) == traverses_forward(t2, e)) {
+        std::swap(triangles[t2][1], triangles[t2][2]);
+        normal[t2] = -normal[t2];
+        ++flipped;
+      }
+      offer(t2);
+    }
+    // A non-orientable cycle closes at an edge whose triangles still disagree: drop
+    // the one reached later (through the worse edge).
+    for (const int t : members)
       for (const int e : tri_edges[t]) {
         if (inc.count(e) != 2)
           continue;
         const std::size_t i = inc.first[e];
         const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
-        const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
-        if (component[t2] < 0) {
-          component[t2] = c;
-          if (same) {
-            std::swap(triangles[t2][1], triangles[t2][2]);
-            ++flipped;
-          }
-          queue.push_back(t2);
-        }
-        else if (same && !drop[t] && !drop[t2])
-          drop[std::max(t, t2)] = 1; // a non-orientable cycle closes here
+        if (t2 < t && traverses_forward(t, e) == traverses_forward(t2, e) && !drop[t] &&
+            !drop[t2])
+          drop[order[t] > order[t2] ? t : t2] = 1;
       }
-    }
     // Turn the component so that its signed volume about its centroid is positive.
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     for (const int t : members)
@@ -201,10 +242,12 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
 }
 
 std::size_t
-fillTriangleHoles(std::vector<Triangle>& triangles,
-                  std::size_t num_vertices,
-                  const std::vector<Triangle>& allowed)
+fillHoles(const std::vector<Eigen::Vector3d>& points,
+          std::vector<Triangle>& triangles,
+          const std::vector<Triangle>& allowed,
+          std::size_t max_edges)
 {
+  const std::size_t num_vertices = points.size();
   const EdgeIncidences inc(triangles);
   // Hole half-edges run against the border half-edges of the triangles.
   std::vector<int> hole_next(num_vertices, -1);
@@ -224,25 +267,100 @@ fillTriangleHoles(std::vector<Triangle>& triangles,
     present.push_back(t);
   }
   std::sort(present.begin(), present.end());
+  const auto is_edge = [&](int a, int b) {
+    return std::binary_search(inc.edges.begin(),
+                              inc.edges.end(),
+                              std::array<int, 2>{std::min(a, b), std::max(a, b)});
+  };
   std::sort(starts.begin(), starts.end());
+  std::vector<std::uint8_t> done(num_vertices, 0);
+  std::vector<int> loop;
   std::size_t added = 0;
   for (const int x : starts) {
-    const int y = hole_next[x];
-    if (y < 0)
+    if (done[x])
       continue;
-    const int z = hole_next[y];
-    if (z < 0 || z == x || hole_next[z] != x)
+    loop.clear();
+    for (int v = x; v >= 0 && !done[v]; v = hole_next[v]) {
+      done[v] = 1;
+      loop.push_back(v);
+    }
+    const std::size_t k = loop.size();
+    if (k < 3 || k > max_edges || hole_next[loop.back()] != x)
       continue;
-    Triangle key{x, y, z};
-    std::sort(key.begin(), key.end());
-    if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
-        std::binary_search(present.begin(), present.end(), key))
+    // The triangulation of the hole's polygon by allowed triangles with the least
+    // total perimeter (dynamic programming over the polygon); no new edge may
+    // already be in the mesh.
+    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
+      Triangle key{loop[i], loop[m], loop[j]};
+      std::sort(key.begin(), key.end());
+      if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
+          std::binary_search(present.begin(), present.end(), key))
+        return false;
+      const auto diagonal = [&](std::size_t a, std::size_t b) {
+        return b - a >= 2 && !(a == 0 && b == k - 1);
+      };
+      return !(diagonal(i, m) && is_edge(loop[i], loop[m])) &&
+             !(diagonal(m, j) && is_edge(loop[m], loop[j])) &&
+             !(diagonal(i, j) && is_edge(loop[i], loop[j]));
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> cost(k * k, inf);
+    std::vector<int> split(k * k, -1);
+    for (std::size_t i = 0; i + 1 < k; ++i)
+      cost[i * k + i + 1] = 0.0;
+    for (std::size_t len = 2; len < k; ++len)
+      for (std::size_t i = 0; i + len < k; ++i) {
+        const std::size_t j = i + len;
+        for (std::size_t m = i + 1; m < j; ++m) {
+          const double c = cost[i * k + m] + cost[m * k + j];
+          if (!(c < inf) || !valid(i, m, j))
+            continue;
+          const Eigen::Vector3d &a = points[loop[i]], &b = points[loop[m]],
+                                &d = points[loop[j]];
+          const double w = c + (a - b).norm() + (b - d).norm() + (d - a).norm();
+          if (w < cost[i * k + j]) {
+            cost[i * k + j] = w;
+            split[i * k + j] = static_cast<int>(m);
+          }
+        }
+      }
+    if (!(cost[k - 1] < inf))
       continue;
-    triangles.push_back({x, y, z});
-    hole_next[x] = hole_next[y] = hole_next[z] = -1;
-    ++added;
+    std::vector<std::array<std::size_t, 2>> stack{{0, k - 1}};
+    while (!stack.empty()) {
+      const auto [i, j] = stack.back();
+      stack.pop_back();
+      if (j - i < 2)
+        continue;
+      const std::size_t m = split[i * k + j];
+      triangles.push_back({loop[i], loop[m], loop[j]});
+      ++added;
+      stack.push_back({i, m});
+      stack.push_back({m, j});
+    }
   }
   return added;
+}
+
+std::size_t
+dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  std::size_t count = 0;
+  const std::vector<int> component = triangleComponents(triangles, &count);
+  const EdgeIncidences inc(triangles);
+  std::vector<std::uint8_t> on_border(num_vertices, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1)
+      on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] = 1;
+  std::vector<std::uint8_t> inner(count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int v : triangles[t])
+      if (!on_border[v])
+        inner[component[t]] = 1;
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    drop[t] = !inner[component[t]];
+  return compact(triangles, drop);
 }
 
 } // namespace cocone

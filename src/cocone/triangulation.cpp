@@ -330,6 +330,111 @@ hullFacets(const Triangulation& triangulation)
   return out;
 }
 
+DelaunayGraph
+delaunayGraph(const Triangulation& triangulation, int threads)
+{
+  DelaunayGraph graph;
+  const std::size_t n = triangulation.points.size();
+  graph.first.assign(n + 1, 0);
+  if (!triangulation.structure)
+    return graph;
+  const Delaunay& dt = triangulation.structure->dt;
+  const int corners = cornersOf(dt);
+  std::vector<Delaunay::Vertex_handle> vertex(n);
+  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v)
+    vertex[v->info()] = v;
+
+  // Blocks of consecutive vertices, each gathered by one thread and then appended in
+  // order: the rows do not depend on the thread count.
+  constexpr std::size_t BLOCK = 4096;
+  const std::size_t blocks = (n + BLOCK - 1) / BLOCK;
+  std::vector<std::vector<int>> rows(blocks);
+  bool failed = false;
+#pragma omp parallel num_threads(threads)
+  {
+    // The cells around v, found by walking across the facets that contain v; an
+    // open-addressing set of the cells seen, cleared after each vertex.
+    std::vector<Delaunay::Cell_handle> stack;
+    std::vector<const void*> seen(256, nullptr);
+    std::vector<std::size_t> used;
+    std::vector<int> around;
+    const auto visit = [&](Delaunay::Cell_handle c) {
+      const std::size_t mask = seen.size() - 1;
+      std::size_t h =
+          (reinterpret_cast<std::uintptr_t>(&*c) * 0x9e3779b97f4a7c15ULL) >> 32;
+      for (h &= mask; seen[h]; h = (h + 1) & mask)
+        if (seen[h] == &*c)
+          return false;
+      seen[h] = &*c;
+      used.push_back(h);
+      return true;
+    };
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(blocks); ++b) {
+      try {
+        std::vector<int>& row = rows[b];
+        const std::size_t end = std::min(n, (b + 1) * BLOCK);
+        for (std::size_t id = b * BLOCK; id < end; ++id) {
+          const Delaunay::Vertex_handle v = vertex[id];
+          around.clear();
+          stack.assign(1, v->cell());
+          visit(v->cell());
+          while (!stack.empty()) {
+            const Delaunay::Cell_handle c = stack.back();
+            stack.pop_back();
+            for (int i = 0; i < corners; ++i) {
+              const Delaunay::Vertex_handle w = c->vertex(i);
+              if (w == v)
+                continue;
+              if (!dt.is_infinite(w))
+                around.push_back(w->info());
+              if (visit(c->neighbor(i)))
+                stack.push_back(c->neighbor(i));
+            }
+            if (4 * used.size() > seen.size()) { // keep the set sparse
+              std::vector<const void*> old;
+              old.swap(seen);
+              seen.assign(2 * old.size(), nullptr);
+              used.clear();
+              for (const void* p : old)
+                if (p)
+                  visit(Delaunay::Cell_handle(
+                      static_cast<Delaunay::Cell*>(const_cast<void*>(p))));
+            }
+          }
+          for (const std::size_t h : used)
+            seen[h] = nullptr;
+          used.clear();
+          std::sort(around.begin(), around.end());
+          around.erase(std::unique(around.begin(), around.end()), around.end());
+          row.push_back(static_cast<int>(around.size()));
+          row.insert(row.end(), around.begin(), around.end());
+        }
+      }
+      catch (const std::bad_alloc&) {
+        __atomic_store_n(&failed, true, __ATOMIC_RELAXED);
+      }
+    }
+  }
+  if (failed)
+    throw std::bad_alloc();
+
+  std::size_t total = 0;
+  for (const auto& row : rows)
+    total += row.size();
+  graph.next.reserve(total - n);
+  std::size_t id = 0;
+  for (auto& row : rows) {
+    for (std::size_t k = 0; k < row.size(); k += row[k] + 1, ++id) {
+      graph.next.insert(
+          graph.next.end(), row.begin() + k + 1, row.begin() + k + 1 + row[k]);
+      graph.first[id + 1] = graph.next.size();
+    }
+    std::vector<int>().swap(row);
+  }
+  return graph;
+}
+
 namespace detail {
 
 void

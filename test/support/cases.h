@@ -23,13 +23,14 @@ options(std::size_t n, double noise = 0.0, double density_ratio = 1.0, bool even
   return o;
 }
 
-/** The paper's flatness test: a fixed rho, no spacing test. */
+/** The paper's flatness test: a fixed rho, no spacing test, no half-disk test. */
 inline pcl::cocone::Parameters
 paper(double ratio = 1.5)
 {
   pcl::cocone::Parameters p;
   p.ratio = ratio;
   p.spacing_factor = 0.0;
+  p.gap_angle = 0.0;
   return p;
 }
 

@@ -28,8 +28,10 @@ namespace pcl {
  *    condition) and its pole line agrees within theta with the pole lines of the
  *    points that have it as a co-cone neighbour (normal condition);
  *  - the interior set grows from the flat points to a fixed point; the rest are
- *    the boundary (undersampled) points.
- *
+ *    the boundary (undersampled) points;
+ *  - beyond the paper (defaults, see setSpacingFactor() and setGapAngle()): a flat
+ *    cell is also at most a few local spacings wide, and a point whose neighbours
+ *    lie on one side only (a half disk) is a rim point, reported with the boundary.
  *
  * The reconstruction (reconstruct()) is the Co-cone algorithm in which only interior
  * points choose triangles: candidate triangles whose dual Voronoi edges meet the
@@ -76,7 +78,8 @@ public:
    * With 0 (the default) rho is chosen from the cloud as
    * clamp(1 / (2 Q95(w / h)), 0.5, 4), Q95 the 95th percentile of width / height
    * over the points; getUsedRatio() tells the value of the last run.
-   * setRatio (1.5) with setSpacingFactor (0) is the paper's test exactly.
+   * setRatio (1.5) with setSpacingFactor (0) and setGapAngle (0) is the paper's test
+   * exactly.
    * \param[in] ratio rho, finite and > 0, or 0 for automatic (default 0)
    */
   void
@@ -113,6 +116,26 @@ public:
   getSpacingFactor() const
   {
     return parameters_.spacing_factor;
+  }
+
+  /** \brief Set the gap angle of the half-disk test.
+   *
+   * A point on a border has its surface neighbours on one side: seen along its pole
+   * line, its neighbours within 1.75 local spacings leave an angular gap larger than
+   * this, and so do those of two of its neighbours (a border is a curve). Such a rim
+   * point is reported as a boundary point even when its Voronoi cell is flat, as
+   * where a scanner grazes the surface or across a slit a few spacings wide; it
+   * chooses only triangles without an interior vertex, within one spacing.
+   * \param[in] angle in radians, in [0, pi); 0 turns the test off (default 80 degrees)
+   */
+  void
+  setGapAngle(double angle);
+
+  /** \brief Get the gap angle of the half-disk test in radians (0 = off). */
+  double
+  getGapAngle() const
+  {
+    return parameters_.gap_angle;
   }
 
   /** \brief Set the normal angle theta of the flatness test.
@@ -202,8 +225,9 @@ public:
   detectBoundary(pcl::PointIndices& boundary);
 
   /** \brief The undersampled points of the last run, indices into the input cloud,
-   * ascending: the boundary set B of the detection, and after reconstruct() also the
-   * points that failed the umbrella check.
+   * ascending: the boundary set B of the detection with the rim points of the
+   * half-disk test, and after reconstruct() also the points that failed the umbrella
+   * check.
    * \param[out] boundary the indices
    */
   void

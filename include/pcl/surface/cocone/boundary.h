@@ -36,7 +36,55 @@ struct FlatnessParameters {
  * border compares with the local feature size.
  */
 std::vector<double>
-localSpacing(const Triangulation& dt);
+localSpacing(const std::vector<Eigen::Vector3d>& points, const DelaunayGraph& graph);
+
+/** \brief Outcome of the half-disk test (see halfDiskTest()). */
+struct HalfDisk {
+  /** Per vertex: the largest angle between consecutive nearby neighbours seen along
+   * the pole line; 2 pi when fewer than two neighbours are near. */
+  std::vector<double> gap;
+  /** The gap angle used: the one asked for, times (median gap / 50 degrees)^2 if
+   * that is more than 1. */
+  double angle = 0.0;
+  /** Per vertex: a rim vertex (gap above the gap angle, and two rim neighbours). */
+  std::vector<std::uint8_t> rim;
+};
+
+/** \brief The half-disk test: a point on a border has its surface neighbours on one
+ * side only.
+ *
+ * The neighbours of p are the vertices within two Delaunay edges of p that lie
+ * within \a reach * s_p of it (s_p: localSpacing()); seen along p's pole line, i.e.
+ * projected on the plane normal to it, they leave an angular gap around p. Inside a
+ * surface the gaps are small, at a border the gap is a half plane or more. The test
+ * sees borders that the Voronoi tests pass: where the scanner grazes a surface a
+ * border point's cell is bounded by the sparse samples beyond it, or by the far
+ * side of a slit a few spacings wide, and is as narrow as an interior cell.
+ *
+ * A vertex is a rim vertex when its gap exceeds the gap angle and at least two of
+ * its Delaunay neighbours within reach have such gaps as well: a border is a curve,
+ * an isolated gap (an irregular spot of an even sample) is not. The gaps inside a
+ * surface grow with the irregularity of the sample: their median is about 50
+ * degrees on range grids and even samples and 75 on area-uniform random samples,
+ * where 80 degrees would flag a third of the points. The gap angle used is
+ * \a gap_angle times (median gap / 50 degrees)^2 when that is larger.
+ *
+ * \param[in] points the triangulation's points
+ * \param[in] graph its Delaunay graph
+ * \param[in] cells stage 2 output (the poles)
+ * \param[in] spacing per vertex s_p (localSpacing())
+ * \param[in] reach neighbours count within reach * s_p
+ * \param[in] gap_angle the largest gap (radians) of a point that is not a rim point
+ * \param[in] threads number of threads (the result does not depend on it)
+ */
+HalfDisk
+halfDiskTest(const std::vector<Eigen::Vector3d>& points,
+             const DelaunayGraph& graph,
+             const VoronoiCells& cells,
+             const std::vector<double>& spacing,
+             double reach,
+             double gap_angle,
+             int threads = 1);
 
 /** \brief The automatic ratio rho = clamp(1 / (2 Q95(w / h)), 0.5, 4).
  *

@@ -32,13 +32,19 @@ enum class CandidateRule {
  * \param[in] boundary per vertex: in B (boundary_detection off: all zero, and every
  *            vertex chooses)
  * \param[in] rule see CandidateRule
- * \param[in] dt the triangulation, needed by the LITERAL rule only
+ * \param[in] dt the triangulation, needed by the LITERAL rule and with \a rim_reach
+ * \param[in] rim_reach per vertex, empty or: finite for a rim vertex of the half-disk
+ *            test (halfDiskTest(), in \a boundary too), the longest edge at it of a
+ *            triangle it chooses. Rim vertices choose only triangles without an
+ *            interior vertex, so that a border band more than one vertex wide keeps
+ *            its triangles while no triangle crosses a rim's gap.
  */
 std::vector<Triangle>
 selectCandidates(const VoronoiCells& cells,
                  const std::vector<std::uint8_t>& boundary,
                  CandidateRule rule = CandidateRule::INTERIOR_CHOOSES,
-                 const Triangulation* dt = nullptr);
+                 const Triangulation* dt = nullptr,
+                 const std::vector<double>& rim_reach = {});
 
 } // namespace cocone
 } // namespace pcl

@@ -26,6 +26,12 @@ struct Parameters {
   /** Spacing factor a of the flatness test (width <= a * local spacing); 0: off,
    * the paper's test. */
   double spacing_factor = 3.0;
+  /** Gap angle of the half-disk test in radians: a point whose nearby neighbours,
+   * seen along its pole line, leave a larger angular gap (and two of whose neighbours
+   * do too) is a rim point (see halfDiskTest()); 0: off. */
+  double gap_angle = 1.3962634015954636; ///< 80 degrees
+  /** Reach of the half-disk test in local spacings s_p. */
+  double gap_reach = 1.75;
   /** Normal angle theta in radians. */
   double normal_angle = 0.5235987755982988; ///< pi / 6
   /** Co-cone angle in radians. */
@@ -34,8 +40,9 @@ struct Parameters {
   bool boundary_detection = true;
   /** Which triangles the interior vertices choose (stage 4). */
   CandidateRule candidate_rule = CandidateRule::INTERIOR_CHOOSES;
-  /** Close border loops of three edges that are one missing Delaunay triangle. */
-  bool fill_triangle_holes = true;
+  /** Close border loops of at most this many edges with Delaunay triangles: holes
+   * below the sampling resolution (one or a few missing triangles); 0: none. */
+  std::size_t fill_hole_edges = 6;
   /** Threads for the parallel stages, 0 for all processors; the output does not
    * depend on it. */
   unsigned int threads = 1;
@@ -74,7 +81,8 @@ struct Result {
   std::vector<int> vertex_of_input;
   /** Number of Delaunay vertices (unique finite points). */
   std::size_t vertices = 0;
-  /** Per vertex: undersampled (not in the interior set of stage 3). */
+  /** Per vertex: undersampled (not in the interior set of stage 3), or a rim point
+   * of the half-disk test. */
   std::vector<std::uint8_t> boundary;
   /** The ratio rho used (the automatic one when Parameters::ratio is 0). */
   double ratio = 0.0;

@@ -24,14 +24,16 @@ struct RepairCounts {
   std::size_t orientation = 0;
   /** Turned over to agree with their component. */
   std::size_t flipped = 0;
-  /** Added to close holes of three edges (single missing triangles). */
+  /** Added to close small holes (see fillHoles()). */
   std::size_t filled = 0;
+  /** Dropped with components that have no inner vertex (see dropRibbons()). */
+  std::size_t ribbon = 0;
 
   /** Triangles dropped in all. */
   std::size_t
   dropped() const
   {
-    return nonmanifold_edge + nonmanifold_vertex + orientation;
+    return nonmanifold_edge + nonmanifold_vertex + orientation + ribbon;
   }
 };
 
@@ -41,9 +43,11 @@ struct RepairCounts {
  * triangle reached through another edge gives a third triangle, and triangles of
  * opposite orientation. At an edge with more than two triangles the consistently
  * oriented pair whose normals agree best is kept; at a vertex with several fans the
- * largest fan is kept; each component is then oriented by a breadth-first pass, and
- * turned so that its signed volume about its centroid is positive (closed
- * components face outward). Repeats until nothing changes.
+ * largest fan is kept; each component is then oriented from its first triangle
+ * across the edges whose triangles agree best in their normals first (so that a
+ * non-orientable fold is cut at the fold, by dropping a triangle there), and turned
+ * so that its signed volume about its centroid is positive (closed components face
+ * outward). Repeats until nothing changes.
  *
  * \param[in] points vertex positions
  * \param[in,out] triangles oriented triangles
@@ -54,17 +58,29 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
                RepairCounts& counts);
 
-/** \brief Close every border loop of exactly three edges whose triangle is in
- * \a allowed (sorted vertex triples, ascending), oriented with its neighbours.
+/** \brief Close border loops of at most \a max_edges edges by triangles from
+ * \a allowed (sorted vertex triples, ascending), oriented with their neighbours.
  *
- * On noisy samples most spurious holes are one missing triangle. The mesh must be a
- * 2-manifold; repairManifold() should run again afterwards.
+ * On noisy samples most spurious holes are one missing triangle. Each loop is
+ * triangulated with the least total perimeter among the triangulations whose
+ * triangles are all allowed and add no edge the mesh already has; a loop without
+ * one stays open. The mesh must be a 2-manifold; repairManifold() should run again
+ * afterwards.
  * \return the number of triangles added
  */
 std::size_t
-fillTriangleHoles(std::vector<Triangle>& triangles,
-                  std::size_t num_vertices,
-                  const std::vector<Triangle>& allowed);
+fillHoles(const std::vector<Eigen::Vector3d>& points,
+          std::vector<Triangle>& triangles,
+          const std::vector<Triangle>& allowed,
+          std::size_t max_edges = 3);
+
+/** \brief Drop every component of the mesh that has no inner vertex (every vertex on
+ * its border): a strip one triangle wide, such as a walk leaves from a border band,
+ * samples no piece of surface.
+ * \return the number of triangles dropped
+ */
+std::size_t
+dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices);
 
 } // namespace cocone
 } // namespace pcl

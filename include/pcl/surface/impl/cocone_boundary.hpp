@@ -53,6 +53,21 @@ CoConeBoundary<PointInT>::setSpacingFactor(double factor)
 
 template <typename PointInT>
 void
+CoConeBoundary<PointInT>::setGapAngle(double angle)
+{
+  if (!(angle >= 0.0 && angle < M_PI)) {
+    PCL_ERROR("[pcl::%s::setGapAngle] The gap angle must be in [0, pi) (got %g); "
+              "keeping %g.\n",
+              getClassName().c_str(),
+              angle,
+              parameters_.gap_angle);
+    return;
+  }
+  parameters_.gap_angle = angle;
+}
+
+template <typename PointInT>
+void
 CoConeBoundary<PointInT>::setNormalAngle(double angle)
 {
   if (!(angle > 0.0 && angle <= M_PI / 2.0)) {
