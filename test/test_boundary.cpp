@@ -118,13 +118,8 @@ TEST(HalfDiskTest, GridBorderAndInterior)
   const Triangulation dt = triangulate(unique.points);
   ASSERT_EQ(dt.dimension, 3);
   const VoronoiCells cells = computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
-  const DelaunayGraph graph = delaunayGraph(dt, 2);
-  const HalfDisk h = halfDiskTest(dt.points,
-                                  graph,
-                                  cells,
-                                  localSpacing(dt.points, graph),
-                                  1.75,
-                                  80.0 * M_PI / 180.0);
+  const HalfDisk h = halfDiskTest(
+      dt.points, cells, localSpacing(dt.points, cells), 1.75, 80.0 * M_PI / 180.0, 2);
   std::size_t border = 0, border_rim = 0, inside_rim = 0;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -102,37 +101,6 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
     EXPECT_EQ(own, shared);
     EXPECT_EQ(4 * cells, hull + 2 * own);
     EXPECT_GT(hull, 0u);
-  }
-}
-
-TEST(DelaunayGraph, TheEdgesOfTheCells)
-{
-  for (const bool planar : {false, true}) {
-    std::vector<Eigen::Vector3d> P;
-    for (int i = 0; i < 300; ++i)
-      P.emplace_back(
-          std::sin(i * 1.7), std::cos(i * 2.3), planar ? 0.0 : std::sin(i * 0.9));
-    const Triangulation dt = triangulate(makeUniquePoints(P).points);
-    ASSERT_EQ(dt.dimension, planar ? 2 : 3);
-    std::vector<std::vector<int>> expected(dt.points.size());
-    forEachCell(dt, 0, 1, [&](const CellView& c, int) {
-      for (int i = 0; i < c.corners; ++i)
-        for (int j = 0; j < c.corners; ++j)
-          if (i != j)
-            expected[c.v[i]].push_back(c.v[j]);
-    });
-    for (const int threads : {1, 2}) {
-      const DelaunayGraph graph = delaunayGraph(dt, threads);
-      ASSERT_EQ(graph.first.size(), dt.points.size() + 1);
-      for (std::size_t v = 0; v < dt.points.size(); ++v) {
-        std::vector<int> e = expected[v];
-        std::sort(e.begin(), e.end());
-        e.erase(std::unique(e.begin(), e.end()), e.end());
-        const std::vector<int> row(graph.next.begin() + graph.first[v],
-                                   graph.next.begin() + graph.first[v + 1]);
-        EXPECT_EQ(row, e) << "vertex " << v << (planar ? " (planar)" : "");
-      }
-    }
   }
 }
 

@@ -10,7 +10,9 @@
 
 #include <support/surfaces.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 using namespace pcl::cocone;
 
@@ -235,4 +237,41 @@ TEST(VoronoiCells, PlanarPointsHaveNormalPoles)
     EXPECT_TRUE(std::isinf(vc.height(v)));
   }
   EXPECT_FALSE(vc.triangles.empty());
+}
+
+TEST(VoronoiCells, NearestDelaunayNeighbours)
+{
+  for (const bool planar : {false, true}) {
+    std::vector<Eigen::Vector3d> P;
+    for (int i = 0; i < 300; ++i) // a deterministic scatter
+      P.emplace_back(
+          std::sin(i * 1.7), std::cos(i * 2.3), planar ? 0.0 : std::sin(i * 0.9));
+    const Triangulation dt = triangulate(makeUniquePoints(P).points);
+    ASSERT_EQ(dt.dimension, planar ? 2 : 3);
+    // The Delaunay neighbours from the cells' edges.
+    std::vector<std::vector<int>> around(dt.points.size());
+    forEachCell(dt, 0, 1, [&](const CellView& c, int) {
+      for (int i = 0; i < c.corners; ++i)
+        for (int j = 0; j < c.corners; ++j)
+          if (i != j)
+            around[c.v[i]].push_back(c.v[j]);
+    });
+    for (const unsigned int threads : {1u, 2u}) {
+      const VoronoiCells vc = computeVoronoiCells(dt, 3.0 * M_PI / 8.0, threads);
+      ASSERT_EQ(vc.nearest.size(), dt.points.size());
+      for (std::size_t v = 0; v < dt.points.size(); ++v) {
+        std::vector<int> e = around[v];
+        std::sort(e.begin(), e.end());
+        e.erase(std::unique(e.begin(), e.end()), e.end());
+        const auto d2 = [&](int w) {
+          return static_cast<float>((dt.points[w] - dt.points[v]).squaredNorm());
+        };
+        std::stable_sort(
+            e.begin(), e.end(), [&](int a, int b) { return d2(a) < d2(b); });
+        e.resize(VoronoiCells::NEAREST, -1);
+        const std::vector<int> kept(vc.nearest[v].begin(), vc.nearest[v].end());
+        EXPECT_EQ(kept, e) << "vertex " << v << (planar ? " (planar)" : "");
+      }
+    }
+  }
 }

@@ -15,39 +15,26 @@ namespace pcl {
 namespace cocone {
 
 std::vector<double>
-localSpacing(const std::vector<Eigen::Vector3d>& points, const DelaunayGraph& graph)
+localSpacing(const std::vector<Eigen::Vector3d>& points, const VoronoiCells& cells)
 {
-  constexpr std::size_t K = 6;
+  constexpr int K = 6;
   const std::size_t n = points.size();
-  // The K nearest Delaunay neighbours of v, as (distance, id), nearest first.
-  std::vector<std::pair<double, int>> near;
-  const auto nearest = [&](std::size_t v) {
-    near.clear();
-    for (std::size_t k = graph.first[v]; k < graph.first[v + 1]; ++k)
-      near.emplace_back((points[graph.next[k]] - points[v]).norm(), graph.next[k]);
-    const std::size_t count = std::min(K, near.size());
-    std::partial_sort(near.begin(), near.begin() + count, near.end());
-    near.resize(count);
-  };
   std::vector<double> mean(n, 0.0);
   for (std::size_t v = 0; v < n; ++v) {
-    nearest(v);
-    for (const auto& e : near)
-      mean[v] += e.first;
-    mean[v] = near.empty() ? 0.0 : mean[v] / near.size();
+    int count = 0;
+    for (; count < K && cells.nearest[v][count] >= 0; ++count)
+      mean[v] += (points[cells.nearest[v][count]] - points[v]).norm();
+    mean[v] = count ? mean[v] / count : 0.0;
   }
   std::vector<double> s = mean;
-  for (std::size_t v = 0; v < n; ++v) {
-    nearest(v);
-    for (const auto& e : near)
-      s[v] = std::max(s[v], mean[e.second]);
-  }
+  for (std::size_t v = 0; v < n; ++v)
+    for (int k = 0; k < K && cells.nearest[v][k] >= 0; ++k)
+      s[v] = std::max(s[v], mean[cells.nearest[v][k]]);
   return s;
 }
 
 HalfDisk
 halfDiskTest(const std::vector<Eigen::Vector3d>& points,
-             const DelaunayGraph& graph,
              const VoronoiCells& cells,
              const std::vector<double>& spacing,
              double reach,
@@ -55,12 +42,16 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
              int threads)
 {
   const std::size_t n = points.size();
-  const auto& first = graph.first;
-  const auto& next = graph.next;
   const auto near = [&](std::size_t p, int q) {
     const double r = reach * spacing[p];
-    return (points[q] - points[p]).squaredNorm() <= r * r;
+    return q >= 0 && (points[q] - points[p]).squaredNorm() <= r * r;
   };
+  // The short Delaunay edges at p: its nearest neighbours within reach.
+  const auto& nearest = cells.nearest;
+  std::vector<std::uint8_t> degree(n, 0);
+  for (std::size_t p = 0; p < n; ++p)
+    while (degree[p] < nearest[p].size() && near(p, nearest[p][degree[p]]))
+      ++degree[p];
 
   HalfDisk out;
   out.gap.assign(n, 2.0 * M_PI);
@@ -73,13 +64,12 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
       const std::size_t p = i;
       // The one-ring alone leaves gaps of up to 120 degrees inside an even sample
       // (an obtuse Delaunay triangle at p); the two-ring closes them.
-      ring.clear();
-      for (std::size_t k = first[p]; k < first[p + 1]; ++k) {
-        if (near(p, next[k]))
-          ring.push_back(next[k]);
-        for (std::size_t j = first[next[k]]; j < first[next[k] + 1]; ++j)
-          if (next[j] != static_cast<int>(p) && near(p, next[j]))
-            ring.push_back(next[j]);
+      ring.assign(nearest[p].begin(), nearest[p].begin() + degree[p]);
+      for (int k = 0; k < degree[p]; ++k) {
+        const int q = nearest[p][k];
+        for (int j = 0; j < degree[q]; ++j)
+          if (nearest[q][j] != static_cast<int>(p) && near(p, nearest[q][j]))
+            ring.push_back(nearest[q][j]);
       }
       std::sort(ring.begin(), ring.end());
       ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
@@ -115,8 +105,8 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
     if (!(out.gap[p] > out.angle))
       continue;
     int support = 0;
-    for (std::size_t k = first[p]; k < first[p + 1]; ++k)
-      support += out.gap[next[k]] > out.angle && near(p, next[k]);
+    for (int k = 0; k < degree[p]; ++k)
+      support += out.gap[nearest[p][k]] > out.angle;
     out.rim[p] = support >= 2;
   }
   return out;

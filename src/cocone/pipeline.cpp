@@ -162,12 +162,9 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   std::vector<double> rim_reach;
   if (parameters.boundary_detection) {
     const bool half_disk = parameters.gap_angle > 0.0;
-    std::vector<double> spacing;
-    DelaunayGraph graph;
-    if (parameters.spacing_factor > 0.0 || half_disk) {
-      graph = delaunayGraph(dt, resolveThreads(parameters.threads));
-      spacing = localSpacing(dt.points, graph);
-    }
+    const std::vector<double> spacing = parameters.spacing_factor > 0.0 || half_disk
+                                            ? localSpacing(dt.points, cells)
+                                            : std::vector<double>();
     const BoundaryLabels labels = detectBoundary(
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
@@ -177,7 +174,6 @@ runStages(const std::vector<Eigen::Vector3d>& points,
       result.boundary[v] = !labels.interior[v];
     if (half_disk) {
       const HalfDisk test = halfDiskTest(dt.points,
-                                         graph,
                                          cells,
                                          spacing,
                                          parameters.gap_reach,

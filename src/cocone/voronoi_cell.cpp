@@ -44,6 +44,69 @@ outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
 }
 
+/** Per vertex the nearest Delaunay neighbours offered so far (VoronoiCells::nearest)
+ * with their squared distances, in float: the order only has to be reproducible. */
+class NearestNeighbours {
+public:
+  static constexpr int K = VoronoiCells::NEAREST;
+
+  NearestNeighbours(std::size_t n) : lists_(n) {}
+
+  /** Offer w, joined to v by a Delaunay edge, to the list of v. */
+  void
+  offer(const std::vector<Eigen::Vector3d>& P, int v, int w)
+  {
+    offer(v, w, static_cast<float>((P[w] - P[v]).squaredNorm()));
+  }
+
+  /** The lists, nearest first, -1 padded. */
+  std::vector<std::array<int, K>>
+  take()
+  {
+    std::vector<std::array<int, K>> ids(lists_.size());
+    for (std::size_t v = 0; v < lists_.size(); ++v)
+      ids[v] = lists_[v].id;
+    std::vector<List>().swap(lists_);
+    return ids;
+  }
+
+private:
+  struct List {
+    std::array<float, K> d2;
+    std::array<int, K> id;
+    List()
+    {
+      d2.fill(std::numeric_limits<float>::infinity());
+      id.fill(-1);
+    }
+  };
+
+  void
+  offer(int v, int w, float d2)
+  {
+    List& l = lists_[v];
+    if (d2 > l.d2[K - 1]) // the common case: farther than the K kept
+      return;
+    const auto after = [&](int k) {
+      return d2 < l.d2[k] || (d2 == l.d2[k] && w < l.id[k]);
+    };
+    int k = K;
+    while (k > 0 && after(k - 1))
+      --k;
+    // Already kept: it sits just before the insertion point (same distance, same id).
+    if (k == K || (k > 0 && l.id[k - 1] == w))
+      return;
+    for (int j = K - 1; j > k; --j) {
+      l.d2[j] = l.d2[j - 1];
+      l.id[j] = l.id[j - 1];
+    }
+    l.d2[k] = d2;
+    l.id[k] = w;
+  }
+
+  std::vector<List> lists_;
+};
+
 /** Coplanar points: every Voronoi cell is a prism over the planar Voronoi polygon. */
 VoronoiCells
 planarCells(const Triangulation& dt, double cocone_angle)
@@ -54,10 +117,13 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.on_hull.assign(n, 0);
   std::vector<double> radius(n, 0.0);
   std::array<int, 3> first{std::numeric_limits<int>::max(), 0, 0};
+  NearestNeighbours nearest(n);
   forEachCell(
       dt, CellView::CIRCUMCENTER | CellView::FACETS, 1, [&](const CellView& cell, int) {
         for (int i = 0; i < 3; ++i) {
           const int v = cell.v[i];
+          nearest.offer(P, v, cell.v[(i + 1) % 3]);
+          nearest.offer(P, v, cell.v[(i + 2) % 3]);
           radius[v] = std::max(radius[v], (cell.circumcenter - P[v]).norm());
           // An outline edge: its two vertices have unbounded planar cells.
           if (cell.facet[i] == FacetRole::HULL) {
@@ -89,6 +155,7 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.width.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     vc.width[v] = vc.on_hull[v] ? INF : radius[v] / s;
+  vc.nearest = nearest.take();
   std::sort(vc.triangles.begin(),
             vc.triangles.end(),
             [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
@@ -207,16 +274,19 @@ computeVoronoiCells(const Triangulation& dt,
   std::vector<double> far2(n, -1.0);
   std::vector<Eigen::Vector3d> far(n);
   std::vector<std::uint8_t> lock(threads > 1 ? n : 0, 0);
+  NearestNeighbours nearest(n);
   forEachCell(dt, CellView::CIRCUMCENTER, threads, [&](const CellView& cell, int) {
     const Eigen::Vector3d& cc = cell.circumcenter;
-    if (!isFinite(cc))
-      return;
-    for (const int v : cell.v) {
+    const bool finite = isFinite(cc);
+    for (int i = 0; i < 4; ++i) {
+      const int v = cell.v[i];
       const double d2 = (cc - P[v]).squaredNorm();
       if (threads > 1)
         while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
         }
-      if (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc))) {
+      for (int j = 1; j < 4; ++j)
+        nearest.offer(P, v, cell.v[(i + j) % 4]);
+      if (finite && (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc)))) {
         far2[v] = d2;
         far[v] = cc;
       }
@@ -225,6 +295,7 @@ computeVoronoiCells(const Triangulation& dt,
     }
   });
   std::vector<std::uint8_t>().swap(lock);
+  vc.nearest = nearest.take();
 
   // The hull facets' outward normals, summed per vertex in facet order so that the
   // sum is reproducible.

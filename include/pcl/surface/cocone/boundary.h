@@ -28,7 +28,7 @@ struct FlatnessParameters {
 };
 
 /** \brief Local sample spacing s_p: the mean distance of p to its 6 nearest Delaunay
- * neighbours, maximised over p and those neighbours.
+ * neighbours (VoronoiCells::nearest), maximised over p and those neighbours.
  *
  * The width of an interior Voronoi cell is about the spacing whatever the scale or
  * the noise (w / s <= 1.3 measured), while at a border the cell reaches out several
@@ -36,7 +36,7 @@ struct FlatnessParameters {
  * border compares with the local feature size.
  */
 std::vector<double>
-localSpacing(const std::vector<Eigen::Vector3d>& points, const DelaunayGraph& graph);
+localSpacing(const std::vector<Eigen::Vector3d>& points, const VoronoiCells& cells);
 
 /** \brief Outcome of the half-disk test (see halfDiskTest()). */
 struct HalfDisk {
@@ -53,8 +53,9 @@ struct HalfDisk {
 /** \brief The half-disk test: a point on a border has its surface neighbours on one
  * side only.
  *
- * The neighbours of p are the vertices within two Delaunay edges of p that lie
- * within \a reach * s_p of it (s_p: localSpacing()); seen along p's pole line, i.e.
+ * The neighbours of p are the vertices within \a reach * s_p of it (s_p:
+ * localSpacing()) joined to it by one or two short Delaunay edges (of the nearest
+ * ones, VoronoiCells::nearest, those within reach); seen along p's pole line, i.e.
  * projected on the plane normal to it, they leave an angular gap around p. Inside a
  * surface the gaps are small, at a border the gap is a half plane or more. The test
  * sees borders that the Voronoi tests pass: where the scanner grazes a surface a
@@ -70,8 +71,7 @@ struct HalfDisk {
  * \a gap_angle times (median gap / 50 degrees)^2 when that is larger.
  *
  * \param[in] points the triangulation's points
- * \param[in] graph its Delaunay graph
- * \param[in] cells stage 2 output (the poles)
+ * \param[in] cells stage 2 output (the poles, the nearest neighbours)
  * \param[in] spacing per vertex s_p (localSpacing())
  * \param[in] reach neighbours count within reach * s_p
  * \param[in] gap_angle the largest gap (radians) of a point that is not a rim point
@@ -79,7 +79,6 @@ struct HalfDisk {
  */
 HalfDisk
 halfDiskTest(const std::vector<Eigen::Vector3d>& points,
-             const DelaunayGraph& graph,
              const VoronoiCells& cells,
              const std::vector<double>& spacing,
              double reach,

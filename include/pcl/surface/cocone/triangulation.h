@@ -112,23 +112,6 @@ struct CellView {
   int corners;
 };
 
-/** \brief The Delaunay graph: the vertices joined to each vertex by a Delaunay edge.
- *
- * Compressed rows: the neighbours of v are next[first[v]] .. next[first[v + 1] - 1],
- * ascending. About 15 per vertex, a twentieth of the memory of the cells.
- */
-struct DelaunayGraph {
-  /** Per vertex the start of its row in next; one more entry for the end. */
-  std::vector<std::size_t> first;
-  /** The rows of neighbour ids, one after the other. */
-  std::vector<int> next;
-};
-
-/** \brief The Delaunay graph of a triangulation not yet released (dimension 2 or 3);
- * the result does not depend on \a threads. */
-DelaunayGraph
-delaunayGraph(const Triangulation& dt, int threads);
-
 /** \brief The facets on the convex hull (dimension 3): three vertex ids ascending,
  * then the id of the vertex across the facet inside the hull; sorted. */
 std::vector<std::array<int, 4>>

@@ -50,6 +50,14 @@ struct VoronoiCells {
   std::vector<std::uint8_t> on_hull;
   /** The Delaunay triangles whose dual edge meets a co-cone, sorted by vertex ids. */
   std::vector<CoconeTriangle> triangles;
+  /** Number of nearest Delaunay neighbours kept per vertex. */
+  static constexpr int NEAREST = 12;
+  /** Per vertex its NEAREST nearest Delaunay neighbours (the sites across the
+   * nearest facets of V_p), nearest first, ties by id; -1 after the last if it has
+   * fewer. Gathered in the first pass over the cells: the local spacing and the
+   * half-disk test of stage 3 read them instead of walking the triangulation again.
+   */
+  std::vector<std::array<int, NEAREST>> nearest;
 
   /** Height h = min(h+, h-). */
   double
