@@ -15,6 +15,9 @@
 #endif
 
 #include <algorithm>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -291,6 +294,23 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
   for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c)
     out.number_of_cells += isFiniteCell(dt, c);
   return out;
+}
+
+void
+Triangulation::release()
+{
+  if (!structure)
+    return;
+  structure.reset();
+#ifdef __GLIBC__
+  // The cells were allocated by the thread that built them, in a malloc arena of
+  // its own, which worker threads reuse later; a small block of theirs left on top
+  // of a heap keeps glibc from unmapping the freed cells, and the later stages
+  // then take new memory from the main arena (measured: peak 1.41 GB instead of
+  // 0.96 GB on a million saddle points with two threads). Trimming releases the
+  // free pages of every arena.
+  malloc_trim(0);
+#endif
 }
 
 int

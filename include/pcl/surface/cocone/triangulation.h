@@ -64,12 +64,9 @@ struct Triangulation {
   /** CGAL's triangulation with the circumcenters; null once released. */
   std::shared_ptr<detail::DelaunayStructure> structure;
 
-  /** Free the cells (the points stay). */
+  /** Free the cells (the points stay) and hand their memory back to the system. */
   void
-  release()
-  {
-    structure.reset();
-  }
+  release();
 };
 
 /** \brief Triangulate unique points (stage 1).
