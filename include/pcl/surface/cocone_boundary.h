@@ -192,8 +192,8 @@ public:
 
   /** \brief Set the number of threads (PCL convention: 0 = all processors).
    *
-   * The output does not depend on it. The Voronoi stage runs in parallel; the others
-   * on one thread.
+   * The output does not depend on it. The passes over the Voronoi cells and the
+   * half-disk test run in parallel; the other stages on one thread.
    * \param[in] nr_threads number of threads, 0 for all (default 1)
    */
   void
