@@ -158,7 +158,8 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   result.timings.voronoi = clock.lap();
 
   result.boundary.assign(result.vertices, 0);
-  // Per rim vertex the longest edge of the triangles it chooses; empty if none.
+  // Per vertex: for a rim vertex the longest edge at it of a triangle it may choose
+  // (its local spacing), infinite for the others; empty without the half-disk test.
   std::vector<double> rim_reach;
   if (parameters.boundary_detection) {
     const bool half_disk = parameters.gap_angle > 0.0;

@@ -275,6 +275,10 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
   std::sort(starts.begin(), starts.end());
   std::vector<std::uint8_t> done(num_vertices, 0);
   std::vector<int> loop;
+  // Per hole: the dynamic programme's tables and the ranges still to triangulate.
+  std::vector<double> cost;
+  std::vector<int> split;
+  std::vector<std::array<std::size_t, 2>> stack;
   std::size_t added = 0;
   for (const int x : starts) {
     if (done[x])
@@ -304,8 +308,8 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
              !(diagonal(i, j) && is_edge(loop[i], loop[j]));
     };
     const double inf = std::numeric_limits<double>::infinity();
-    std::vector<double> cost(k * k, inf);
-    std::vector<int> split(k * k, -1);
+    cost.assign(k * k, inf);
+    split.assign(k * k, -1);
     for (std::size_t i = 0; i + 1 < k; ++i)
       cost[i * k + i + 1] = 0.0;
     for (std::size_t len = 2; len < k; ++len)
@@ -326,7 +330,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       }
     if (!(cost[k - 1] < inf))
       continue;
-    std::vector<std::array<std::size_t, 2>> stack{{0, k - 1}};
+    stack.assign(1, {0, k - 1});
     while (!stack.empty()) {
       const auto [i, j] = stack.back();
       stack.pop_back();

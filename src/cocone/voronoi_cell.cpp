@@ -44,67 +44,60 @@ outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
 }
 
-/** Per vertex the nearest Delaunay neighbours offered so far (VoronoiCells::nearest)
- * with their squared distances, in float: the order only has to be reproducible. */
+/** Gathers VoronoiCells::nearest: per vertex the nearest Delaunay neighbours offered
+ * so far, with their squared distances in float beside them (the order only has to
+ * be reproducible). */
 class NearestNeighbours {
 public:
   static constexpr int K = VoronoiCells::NEAREST;
 
-  NearestNeighbours(std::size_t n) : lists_(n) {}
+  /** Fill \a ids, one list per vertex, -1 padded. */
+  NearestNeighbours(std::vector<std::array<int, K>>& ids, std::size_t n) : ids_(ids)
+  {
+    std::array<int, K> none;
+    none.fill(-1);
+    ids_.assign(n, none);
+    std::array<float, K> far;
+    far.fill(std::numeric_limits<float>::infinity());
+    d2_.assign(n, far);
+  }
 
   /** Offer w, joined to v by a Delaunay edge, to the list of v. */
   void
   offer(const std::vector<Eigen::Vector3d>& P, int v, int w)
   {
-    offer(v, w, static_cast<float>((P[w] - P[v]).squaredNorm()));
-  }
-
-  /** The lists, nearest first, -1 padded. */
-  std::vector<std::array<int, K>>
-  take()
-  {
-    std::vector<std::array<int, K>> ids(lists_.size());
-    for (std::size_t v = 0; v < lists_.size(); ++v)
-      ids[v] = lists_[v].id;
-    std::vector<List>().swap(lists_);
-    return ids;
-  }
-
-private:
-  struct List {
-    std::array<float, K> d2;
-    std::array<int, K> id;
-    List()
-    {
-      d2.fill(std::numeric_limits<float>::infinity());
-      id.fill(-1);
-    }
-  };
-
-  void
-  offer(int v, int w, float d2)
-  {
-    List& l = lists_[v];
-    if (d2 > l.d2[K - 1]) // the common case: farther than the K kept
+    const float d2 = static_cast<float>((P[w] - P[v]).squaredNorm());
+    auto& ids = ids_[v];
+    auto& d2s = d2_[v];
+    if (d2 > d2s[K - 1]) // the common case: farther than the K kept
       return;
     const auto after = [&](int k) {
-      return d2 < l.d2[k] || (d2 == l.d2[k] && w < l.id[k]);
+      return d2 < d2s[k] || (d2 == d2s[k] && w < ids[k]);
     };
     int k = K;
     while (k > 0 && after(k - 1))
       --k;
     // Already kept: it sits just before the insertion point (same distance, same id).
-    if (k == K || (k > 0 && l.id[k - 1] == w))
+    if (k == K || (k > 0 && ids[k - 1] == w))
       return;
     for (int j = K - 1; j > k; --j) {
-      l.d2[j] = l.d2[j - 1];
-      l.id[j] = l.id[j - 1];
+      d2s[j] = d2s[j - 1];
+      ids[j] = ids[j - 1];
     }
-    l.d2[k] = d2;
-    l.id[k] = w;
+    d2s[k] = d2;
+    ids[k] = w;
   }
 
-  std::vector<List> lists_;
+  /** Free the distances; the lists stay. */
+  void
+  release()
+  {
+    std::vector<std::array<float, K>>().swap(d2_);
+  }
+
+private:
+  std::vector<std::array<int, K>>& ids_;
+  std::vector<std::array<float, K>> d2_;
 };
 
 /** Coplanar points: every Voronoi cell is a prism over the planar Voronoi polygon. */
@@ -117,7 +110,7 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.on_hull.assign(n, 0);
   std::vector<double> radius(n, 0.0);
   std::array<int, 3> first{std::numeric_limits<int>::max(), 0, 0};
-  NearestNeighbours nearest(n);
+  NearestNeighbours nearest(vc.nearest, n);
   forEachCell(
       dt, CellView::CIRCUMCENTER | CellView::FACETS, 1, [&](const CellView& cell, int) {
         for (int i = 0; i < 3; ++i) {
@@ -155,7 +148,7 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.width.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     vc.width[v] = vc.on_hull[v] ? INF : radius[v] / s;
-  vc.nearest = nearest.take();
+  nearest.release();
   std::sort(vc.triangles.begin(),
             vc.triangles.end(),
             [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
@@ -274,7 +267,7 @@ computeVoronoiCells(const Triangulation& dt,
   std::vector<double> far2(n, -1.0);
   std::vector<Eigen::Vector3d> far(n);
   std::vector<std::uint8_t> lock(threads > 1 ? n : 0, 0);
-  NearestNeighbours nearest(n);
+  NearestNeighbours nearest(vc.nearest, n);
   forEachCell(dt, CellView::CIRCUMCENTER, threads, [&](const CellView& cell, int) {
     const Eigen::Vector3d& cc = cell.circumcenter;
     const bool finite = isFinite(cc);
@@ -295,7 +288,7 @@ computeVoronoiCells(const Triangulation& dt,
     }
   });
   std::vector<std::uint8_t>().swap(lock);
-  vc.nearest = nearest.take();
+  nearest.release();
 
   // The hull facets' outward normals, summed per vertex in facet order so that the
   // sum is reproducible.
