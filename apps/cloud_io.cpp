@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -82,6 +83,17 @@ parseCount(const std::string& token, std::size_t& value)
 bool
 checkPcdHeader(const std::string& path, std::string& error)
 {
+  static const std::set<std::string> KEYS{"VERSION",
+                                          "FIELDS",
+                                          "COLUMNS",
+                                          "SIZE",
+                                          "TYPE",
+                                          "COUNT",
+                                          "WIDTH",
+                                          "HEIGHT",
+                                          "VIEWPOINT",
+                                          "POINTS",
+                                          "DATA"};
   std::ifstream in(path, std::ios::binary);
   std::vector<std::string> fields, sizes, types, counts;
   std::size_t width = 0, height = 1, points = 0;
@@ -110,17 +122,6 @@ checkPcdHeader(const std::string& path, std::string& error)
     if (key.empty() || key[0] == '#')
       continue;
     // Only the keys of the format, each once: PCL's parser matches others loosely.
-    static const std::set<std::string> KEYS{"VERSION",
-                                            "FIELDS",
-                                            "COLUMNS",
-                                            "SIZE",
-                                            "TYPE",
-                                            "COUNT",
-                                            "WIDTH",
-                                            "HEIGHT",
-                                            "VIEWPOINT",
-                                            "POINTS",
-                                            "DATA"};
     if (!KEYS.count(key) || !seen.insert(key).second)
       break;
     if (key == "FIELDS" || key == "COLUMNS")
@@ -178,6 +179,28 @@ checkPcdHeader(const std::string& path, std::string& error)
     in.read(reinterpret_cast<char*>(sizes_of), sizeof(sizes_of));
     if (!in || sizes_of[1] != n * step || sizes_of[0] > file_size - data_start - 8)
       return false;
+  }
+  // PCL's parser reads on after DATA, skipping empty lines and comments, while the
+  // first word of a line starts like a key; a key there declares the fields again
+  // behind the reader's back (a use after free in PCL 1.13). Refuse such data.
+  std::ifstream rest(path, std::ios::binary);
+  rest.seekg(static_cast<std::streamoff>(data_start));
+  char buffer[256];
+  for (int lines = 0; lines < 64 && rest.good(); ++lines) {
+    rest.getline(buffer, sizeof(buffer));
+    if (rest.fail() && !rest.eof()) { // a longer line: its start is enough
+      rest.clear();
+      rest.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    }
+    std::istringstream tokens(buffer);
+    std::string first;
+    tokens >> first;
+    if (buffer[0] == '\0' || (!first.empty() && first[0] == '#'))
+      continue;
+    for (const auto& key : KEYS)
+      if (first.compare(0, key.size(), key) == 0)
+        return false;
+    break;
   }
   error.clear();
   return true;

@@ -227,6 +227,11 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
   std::ofstream(dir_ + "/empty.xyz").close();
   std::ofstream(dir_ + "/bad.xyz") << "1 2 3\n4 five 6\n";
   std::ofstream(dir_ + "/bad.pcd") << "this is not a point cloud\n";
+  // PCL's parser would read on after DATA and take this line for new fields.
+  std::ofstream(dir_ + "/redeclared.pcd")
+      << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4\n"
+         "HEIGHT 1\nPOINTS 4\nDATA ascii\n\n# data\nCOLUMNS a\n0 0 0\n1 0 0\n0 1 0\n"
+         "0 0 1\n";
   std::ofstream(dir_ + "/line.xyz") << "0 0 0\n1 1 1\n2 2 2\n3 3 3\n4 4 4\n";
   const std::string in = dir_ + "/in.pcd ";
   const std::pair<std::string, std::string> cases[] = {
@@ -237,6 +242,7 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
       {dir_ + "/empty.xyz " + out, "cannot read"},
       {dir_ + "/bad.xyz " + out, "line 2"},
       {dir_ + "/bad.pcd " + out, "cannot read"},
+      {dir_ + "/redeclared.pcd " + out, "cannot read"},
       {dir_ + "/line.xyz " + out, "collinear"},
       {in + out + " -rho abc", "not a number"},
       {in + out + " -rho -1", "-rho must be positive"},
