@@ -13,6 +13,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
+#include <vector>
+
 namespace pcl {
 namespace cocone {
 namespace detail {
@@ -28,6 +30,11 @@ using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
 
 struct DelaunayStructure {
   Delaunay dt;
+  /** The finite cells in the order the passes visit them: by smallest vertex id.
+   * CGAL's container reuses freed slots, so its order scatters neighbouring cells;
+   * in this order the cells across a cell's facets and the per-vertex records of
+   * its vertices are mostly still in cache. */
+  std::vector<Delaunay::Cell_handle> cells;
 };
 
 } // namespace detail

@@ -145,7 +145,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
     return result;
   }
 
-  Triangulation dt = triangulate(unique.points);
+  Triangulation dt = triangulate(std::move(unique.points));
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";
@@ -153,7 +153,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   }
   result.offset = dt.offset;
 
-  const VoronoiCells cells =
+  VoronoiCells cells =
       computeVoronoiCells(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
 
@@ -188,6 +188,8 @@ runStages(const std::vector<Eigen::Vector3d>& points,
         }
     }
   }
+  // Stage 3 was the last to read the neighbour lists: make room for stage 4.
+  std::vector<std::array<int, VoronoiCells::NEAREST>>().swap(cells.nearest);
   result.timings.boundary = clock.lap();
 
   result.umbrella_failed.assign(result.vertices, 0);

@@ -194,11 +194,44 @@ circumcenterOf(const Delaunay& dt, Delaunay::Cell_handle c)
                       : triangleCircumcenter(p(0), p(1), p(2));
 }
 
+/** Fill structure.cells: the finite cells by their smallest vertex id, in buckets
+ * of 64 ids (a few hundred cells: a counting sort with few write positions; inside
+ * a bucket the container's order, which does not matter). */
+void
+orderCells(detail::DelaunayStructure& structure, std::size_t number_of_vertices)
+{
+  const Delaunay& dt = structure.dt;
+  const int corners = cornersOf(dt);
+  std::vector<int> key;
+  key.reserve(dt.tds().number_of_cells());
+  constexpr int BUCKET_BITS = 6;
+  std::vector<std::uint32_t> start((number_of_vertices >> BUCKET_BITS) + 2, 0);
+  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c) {
+    int lowest = -1;
+    if (isFiniteCell(dt, c)) {
+      lowest = c->vertex(0)->info();
+      for (int i = 1; i < corners; ++i)
+        lowest = std::min(lowest, c->vertex(i)->info());
+      lowest >>= BUCKET_BITS;
+      ++start[lowest + 1];
+    }
+    key.push_back(lowest);
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  structure.cells.resize(start.back());
+  auto k = key.begin();
+  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c, ++k)
+    if (*k >= 0)
+      structure.cells[start[*k]++] = c;
+}
+
 /** Run body(cell, thread) over the finite cells, split in equal runs per thread. */
 template <typename Body>
 void
-splitCells(const Delaunay& dt, std::size_t count, int threads, const Body& body)
+splitCells(const detail::DelaunayStructure& structure, int threads, const Body& body)
 {
+  constexpr std::size_t AHEAD = 8;
+  const int corners = cornersOf(structure.dt);
   // An exception must not leave a parallel region: it is caught in the thread and
   // thrown again after the region (only std::bad_alloc can occur here).
   bool failed = false;
@@ -209,16 +242,27 @@ splitCells(const Delaunay& dt, std::size_t count, int threads, const Body& body)
 #else
     const int thread = 0, team = 1;
 #endif
+    const std::size_t count = structure.cells.size();
     const std::size_t begin = count * thread / team, end = count * (thread + 1) / team;
-    std::size_t k = 0;
     try {
-      for (auto c = dt.tds().raw_cells_begin();
-           c != dt.tds().raw_cells_end() && k < end;
-           ++c) {
-        if (!isFiniteCell(dt, c))
-          continue;
-        if (k++ >= begin)
-          body(c, thread);
+      for (std::size_t k = begin; k < end; ++k) {
+        // The cells lie scattered in memory: fetch ahead, the cell first, then its
+        // vertices once the cell has arrived; the body gets a cell further on still
+        // whose vertices have arrived, to fetch its own records.
+        if (k + 3 * AHEAD < end) {
+          const char* ahead =
+              reinterpret_cast<const char*>(&*structure.cells[k + 3 * AHEAD]);
+          __builtin_prefetch(ahead);
+          __builtin_prefetch(ahead + 64);
+        }
+        if (k + 2 * AHEAD < end) {
+          const auto c = structure.cells[k + 2 * AHEAD];
+          for (int i = 0; i < corners; ++i)
+            __builtin_prefetch(&*c->vertex(i));
+        }
+        body(structure.cells[k],
+             k + AHEAD < end ? structure.cells[k + AHEAD] : Delaunay::Cell_handle(),
+             thread);
       }
     }
     catch (const std::bad_alloc&) {
@@ -232,7 +276,7 @@ splitCells(const Delaunay& dt, std::size_t count, int threads, const Body& body)
 } // namespace
 
 Triangulation
-triangulate(const std::vector<Eigen::Vector3d>& points)
+triangulate(std::vector<Eigen::Vector3d> points)
 {
   Triangulation out;
   if (points.empty())
@@ -243,13 +287,13 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
   // coordinates are exact in double, so a translated cloud gives the very same
   // recentred points, and the same triangulation even where it is degenerate.
   out.offset = *std::min_element(points.begin(), points.end(), lexLess);
-  out.points.reserve(points.size());
-  for (const auto& p : points)
-    out.points.push_back(p - out.offset);
+  for (auto& p : points)
+    p -= out.offset;
+  out.points = std::move(points);
 
   std::vector<std::pair<Kernel::Point_3, int>> sites;
-  sites.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  sites.reserve(out.points.size());
+  for (std::size_t i = 0; i < out.points.size(); ++i) {
     const auto& p = out.points[i];
     sites.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), static_cast<int>(i));
   }
@@ -291,8 +335,8 @@ triangulate(const std::vector<Eigen::Vector3d>& points)
     return out;
   }
 
-  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c)
-    out.number_of_cells += isFiniteCell(dt, c);
+  orderCells(*out.structure, out.points.size());
+  out.number_of_cells = out.structure->cells.size();
   return out;
 }
 
@@ -384,16 +428,27 @@ visitCells(const Triangulation& triangulation,
     }
     return e.circumcenter;
   };
-  splitCells(dt,
-             triangulation.number_of_cells,
+  splitCells(*triangulation.structure,
              threads,
-             [&](Delaunay::Cell_handle c, int thread) {
+             [&](Delaunay::Cell_handle c, Delaunay::Cell_handle ahead, int thread) {
                auto& cache = caches[thread];
                CellView view;
                view.corners = corners;
                view.v = {-1, -1, -1, -1};
-               for (int i = 0; i < corners; ++i)
+               view.ahead = {-1, -1, -1, -1};
+               for (int i = 0; i < corners; ++i) {
                  view.v[i] = c->vertex(i)->info();
+                 if (ahead != Delaunay::Cell_handle())
+                   view.ahead[i] = ahead->vertex(i)->info();
+               }
+               if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS &&
+                   ahead != Delaunay::Cell_handle())
+                 for (int i = 0; i < corners; ++i) {
+                   const char* other =
+                       reinterpret_cast<const char*>(&*ahead->neighbor(i));
+                   __builtin_prefetch(other);
+                   __builtin_prefetch(other + 64);
+                 }
                if (data & CellView::CIRCUMCENTER)
                  view.circumcenter = cached(cache, c);
                for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
@@ -402,9 +457,9 @@ visitCells(const Triangulation& triangulation,
                    continue;
                  }
                  const auto other = c->neighbor(i);
-                 // Each interior facet once: from the cell at the higher address,
-                 // visited after the other one, whose circumcenter is then likely
-                 // still cached. Which cell it is does not matter to the visitors.
+                 // Each interior facet once: from the cell at the higher address
+                 // (which one does not matter to the visitors; both are visited
+                 // close together, so the other's circumcenter is mostly cached).
                  if (!isFiniteCell(dt, other))
                    view.facet[i] = FacetRole::HULL;
                  else if (&*other > &*c)

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <deque>
 
 namespace pcl {
 namespace cocone {
@@ -45,59 +46,80 @@ outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f
 }
 
 /** Gathers VoronoiCells::nearest: per vertex the nearest Delaunay neighbours offered
- * so far, with their squared distances in float beside them (the order only has to
- * be reproducible). */
+ * so far (ties by id). Only the distance of the last one kept is stored; the others
+ * are recomputed when a new neighbour comes in, which is rare: most offers are of a
+ * neighbour too far or already kept, since about ten cells share an edge. */
 class NearestNeighbours {
 public:
   static constexpr int K = VoronoiCells::NEAREST;
 
   /** Fill \a ids, one list per vertex, -1 padded. */
-  NearestNeighbours(std::vector<std::array<int, K>>& ids, std::size_t n) : ids_(ids)
+  NearestNeighbours(const std::vector<Eigen::Vector3d>& points,
+                    std::vector<std::array<int, K>>& ids)
+  : P_(points), ids_(ids)
   {
     std::array<int, K> none;
     none.fill(-1);
-    ids_.assign(n, none);
-    std::array<float, K> far;
-    far.fill(std::numeric_limits<float>::infinity());
-    d2_.assign(n, far);
+    ids_.assign(P_.size(), none);
+    worst_.assign(P_.size(), std::numeric_limits<float>::infinity());
   }
 
-  /** Offer w, joined to v by a Delaunay edge, to the list of v. */
-  void
-  offer(const std::vector<Eigen::Vector3d>& P, int v, int w)
+  /** Squared length of the edge vw, as the lists compare it: the same bits from
+   * either end. */
+  float
+  distance2(int v, int w) const
   {
-    const float d2 = static_cast<float>((P[w] - P[v]).squaredNorm());
+    return w < 0 ? std::numeric_limits<float>::infinity()
+                 : static_cast<float>((P_[w] - P_[v]).squaredNorm());
+  }
+
+  /** Offer w, joined to v by a Delaunay edge of squared length d2, to the list of
+   * v. */
+  void
+  offer(int v, int w, float d2)
+  {
+    if (d2 > worst_[v])
+      return;
     auto& ids = ids_[v];
-    auto& d2s = d2_[v];
-    if (d2 > d2s[K - 1]) // the common case: farther than the K kept
+    bool kept = false; // one vector compare
+    for (int k = 0; k < K; ++k)
+      kept |= ids[k] == w;
+    if (kept)
       return;
-    const auto after = [&](int k) {
-      return d2 < d2s[k] || (d2 == d2s[k] && w < ids[k]);
-    };
     int k = K;
-    while (k > 0 && after(k - 1))
-      --k;
-    // Already kept: it sits just before the insertion point (same distance, same id).
-    if (k == K || (k > 0 && ids[k - 1] == w))
-      return;
-    for (int j = K - 1; j > k; --j) {
-      d2s[j] = d2s[j - 1];
-      ids[j] = ids[j - 1];
+    for (; k > 0; --k) {
+      const float d2k = distance2(v, ids[k - 1]);
+      if (!(d2 < d2k || (d2 == d2k && w < ids[k - 1])))
+        break;
     }
-    d2s[k] = d2;
+    if (k == K)
+      return;
+    for (int j = K - 1; j > k; --j)
+      ids[j] = ids[j - 1];
     ids[k] = w;
+    worst_[v] = distance2(v, ids[K - 1]);
+  }
+
+  /** Fetch the list of v into the cache. */
+  void
+  prefetch(int v) const
+  {
+    __builtin_prefetch(&ids_[v].front()); // a list may straddle two cache lines
+    __builtin_prefetch(&ids_[v].back());
+    __builtin_prefetch(&worst_[v]);
   }
 
   /** Free the distances; the lists stay. */
   void
   release()
   {
-    std::vector<std::array<float, K>>().swap(d2_);
+    std::vector<float>().swap(worst_);
   }
 
 private:
+  const std::vector<Eigen::Vector3d>& P_;
   std::vector<std::array<int, K>>& ids_;
-  std::vector<std::array<float, K>> d2_;
+  std::vector<float> worst_;
 };
 
 /** Coplanar points: every Voronoi cell is a prism over the planar Voronoi polygon. */
@@ -110,13 +132,13 @@ planarCells(const Triangulation& dt, double cocone_angle)
   vc.on_hull.assign(n, 0);
   std::vector<double> radius(n, 0.0);
   std::array<int, 3> first{std::numeric_limits<int>::max(), 0, 0};
-  NearestNeighbours nearest(vc.nearest, n);
+  NearestNeighbours nearest(P, vc.nearest);
   forEachCell(
       dt, CellView::CIRCUMCENTER | CellView::FACETS, 1, [&](const CellView& cell, int) {
         for (int i = 0; i < 3; ++i) {
-          const int v = cell.v[i];
-          nearest.offer(P, v, cell.v[(i + 1) % 3]);
-          nearest.offer(P, v, cell.v[(i + 2) % 3]);
+          const int v = cell.v[i], a = cell.v[(i + 1) % 3], b = cell.v[(i + 2) % 3];
+          nearest.offer(v, a, nearest.distance2(v, a));
+          nearest.offer(v, b, nearest.distance2(v, b));
           radius[v] = std::max(radius[v], (cell.circumcenter - P[v]).norm());
           // An outline edge: its two vertices have unbounded planar cells.
           if (cell.facet[i] == FacetRole::HULL) {
@@ -263,22 +285,38 @@ computeVoronoiCells(const Triangulation& dt,
 
   // Pass 1 over the cells: the positive pole, the farthest Voronoi vertex (ties
   // broken by position, so the choice does not depend on the visiting order). With
-  // several threads a vertex's record is updated under its own spin lock.
-  std::vector<double> far2(n, -1.0);
-  std::vector<Eigen::Vector3d> far(n);
+  // several threads a vertex's record is updated under its own spin lock. The
+  // squared distance and the vertex are kept where h+ and the pole go.
+  std::vector<double>& far2 = vc.height_plus;
+  std::vector<Eigen::Vector3d>& far = vc.pole;
+  far2.assign(n, -1.0);
+  far.assign(n, Eigen::Vector3d::Zero());
   std::vector<std::uint8_t> lock(threads > 1 ? n : 0, 0);
-  NearestNeighbours nearest(vc.nearest, n);
+  NearestNeighbours nearest(P, vc.nearest);
   forEachCell(dt, CellView::CIRCUMCENTER, threads, [&](const CellView& cell, int) {
+    for (const int a : cell.ahead)
+      if (a >= 0) {
+        nearest.prefetch(a);
+        __builtin_prefetch(&far2[a]);
+        __builtin_prefetch(&far[a]);
+        __builtin_prefetch(&P[a]);
+      }
     const Eigen::Vector3d& cc = cell.circumcenter;
     const bool finite = isFinite(cc);
+    // The six edges' lengths, each offered to both its ends.
+    std::array<std::array<float, 4>, 4> edge2;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        edge2[i][j] = edge2[j][i] = nearest.distance2(cell.v[i], cell.v[j]);
     for (int i = 0; i < 4; ++i) {
       const int v = cell.v[i];
       const double d2 = (cc - P[v]).squaredNorm();
       if (threads > 1)
         while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
         }
-      for (int j = 1; j < 4; ++j)
-        nearest.offer(P, v, cell.v[(i + j) % 4]);
+      for (int j = 0; j < 4; ++j)
+        if (j != i)
+          nearest.offer(v, cell.v[j], edge2[i][j]);
       if (finite && (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc)))) {
         far2[v] = d2;
         far[v] = cc;
@@ -290,36 +328,43 @@ computeVoronoiCells(const Triangulation& dt,
   std::vector<std::uint8_t>().swap(lock);
   nearest.release();
 
-  // The hull facets' outward normals, summed per vertex in facet order so that the
-  // sum is reproducible.
-  struct HullFacet {
-    std::array<int, 3> f;
-    Eigen::Vector3d normal;
+  // The pole of a vertex on the convex hull: the sum of the outward normals of its
+  // hull facets, added in facet order so that the sum is reproducible. (A sampled
+  // closed surface can have half its points on the hull: no per-facet records.)
+  const std::vector<std::array<int, 4>> hull = hullFacets(dt);
+  const auto hullNormal = [&](const std::array<int, 4>& h) {
+    return outwardNormal(P, {h[0], h[1], h[2]}, h[3]);
   };
-  std::vector<HullFacet> hull;
-  for (const auto& h : hullFacets(dt)) {
-    const std::array<int, 3> f{h[0], h[1], h[2]};
-    hull.push_back({f, outwardNormal(P, f, h[3])});
-  }
-  std::vector<Eigen::Vector3d> hull_sum(n, Eigen::Vector3d::Zero());
+  std::vector<int> slot(n, -1);
+  int hull_vertices = 0;
   for (const auto& h : hull)
-    for (const int v : h.f) {
-      hull_sum[v] += h.normal;
-      vc.on_hull[v] = 1;
-    }
-  vc.pole.assign(n, Eigen::Vector3d::Zero());
-  vc.height_plus.assign(n, INF);
+    for (int k = 0; k < 3; ++k)
+      if (slot[h[k]] < 0) {
+        slot[h[k]] = hull_vertices++;
+        vc.on_hull[h[k]] = 1;
+      }
+  std::vector<Eigen::Vector3d> sum(hull_vertices, Eigen::Vector3d::Zero());
+  for (const auto& h : hull) {
+    const Eigen::Vector3d normal = hullNormal(h);
+    for (int k = 0; k < 3; ++k)
+      sum[slot[h[k]]] += normal;
+  }
   for (std::size_t v = 0; v < n; ++v) {
-    if (vc.on_hull[v] && hull_sum[v].norm() > 0.0)
-      vc.pole[v] = hull_sum[v].normalized();
+    if (vc.on_hull[v] && sum[slot[v]].norm() > 0.0) {
+      far2[v] = INF;
+      far[v] = sum[slot[v]].normalized();
+    }
     else if (far2[v] > 0.0) {
-      vc.height_plus[v] = std::sqrt(far2[v]);
-      vc.pole[v] = (far[v] - P[v]) / vc.height_plus[v];
+      far2[v] = std::sqrt(far2[v]);
+      far[v] = (far[v] - P[v]) / far2[v];
+    }
+    else {
+      far2[v] = INF;
+      far[v].setZero();
     }
   }
-  std::vector<double>().swap(far2);
-  std::vector<Eigen::Vector3d>().swap(far);
-  std::vector<Eigen::Vector3d>().swap(hull_sum);
+  std::vector<int>().swap(slot);
+  std::vector<Eigen::Vector3d>().swap(sum);
 
   // Pass 2: the negative pole (the farthest Voronoi vertex on the other side of p),
   // then the width and the co-cone triangles over the Voronoi edges, i.e. over the
@@ -329,11 +374,19 @@ computeVoronoiCells(const Triangulation& dt,
   const double cos_angle = std::cos(cocone_angle);
   std::vector<std::uint64_t> neg2(n, 0), width(n, 0); // bits of non-negative doubles
   std::vector<std::uint8_t> met(n, 0);
-  std::vector<std::vector<CoconeTriangle>> found(threads);
+  // Chunked, so that collecting them never holds two copies (no reallocation).
+  std::vector<std::deque<CoconeTriangle>> found(threads);
   forEachCell(dt,
               CellView::CIRCUMCENTER | CellView::NEIGHBORS,
               threads,
               [&](const CellView& cell, int thread) {
+                for (const int a : cell.ahead)
+                  if (a >= 0) {
+                    __builtin_prefetch(&P[a]);
+                    __builtin_prefetch(&vc.pole[a]);
+                    __builtin_prefetch(&neg2[a]);
+                    __builtin_prefetch(&width[a]);
+                  }
                 const Eigen::Vector3d& cc = cell.circumcenter;
                 if (isFinite(cc))
                   for (const int v : cell.v) {
@@ -379,19 +432,20 @@ computeVoronoiCells(const Triangulation& dt,
   for (std::size_t v = 0; v < n; ++v)
     vc.height_minus[v] = std::sqrt(doubleOf(neg2[v]));
   // An unbounded Voronoi edge going to the negative side puts v- at infinity.
-  for (const auto& h : hull)
-    for (const int v : h.f)
-      if (h.normal.dot(vc.pole[v]) < 0.0)
-        vc.height_minus[v] = INF;
+  for (const auto& h : hull) {
+    const Eigen::Vector3d normal = hullNormal(h);
+    for (int k = 0; k < 3; ++k)
+      if (normal.dot(vc.pole[h[k]]) < 0.0)
+        vc.height_minus[h[k]] = INF;
+  }
 
   std::size_t total = 0;
   for (const auto& t : found)
     total += t.size();
   vc.triangles.reserve(total);
-  for (auto& t : found) {
-    vc.triangles.insert(vc.triangles.end(), t.begin(), t.end());
-    std::vector<CoconeTriangle>().swap(t);
-  }
+  for (auto& t : found)
+    for (; !t.empty(); t.pop_front()) // frees each chunk once copied
+      vc.triangles.push_back(t.front());
   vc.width.resize(n);
   // A co-cone that meets no Voronoi edge tells nothing about flatness: not flat.
   for (std::size_t v = 0; v < n; ++v)

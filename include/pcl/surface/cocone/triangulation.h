@@ -41,10 +41,12 @@ struct DelaunayStructure;
 
 /** \brief Stage 1: the Delaunay triangulation (exact predicates).
  *
- * The cells stay in CGAL's structure while the passes of stages 2 and 3 run over
- * them (forEachCell()); then release() frees it. A copy into flat arrays, or a
+ * The cells stay in CGAL's structure while the passes of stages 2 and 4 run over
+ * them (forEachCell()), in an order of their own kept beside them (one handle per
+ * cell, by smallest vertex id: neighbouring cells and their vertices' records are
+ * visited close together); then release() frees it. A copy into flat arrays, or a
  * stored circumcenter per cell, would raise the peak memory of the whole pipeline
- * by a half: irregular samples have about 19 cells per point, and CGAL's structure
+ * by a half: random samples have about 14 cells per point, and CGAL's structure
  * is the largest thing the pipeline holds. The circumcenters (the Voronoi vertices)
  * are recomputed where a pass needs them instead, always from the vertices in
  * ascending id order, so that every pass sees the same bits.
@@ -72,10 +74,11 @@ struct Triangulation {
 /** \brief Triangulate unique points (stage 1).
  *
  * \param[in] points unique points (see makeUniquePoints); vertex v of the result
- *            is points[v]
+ *            is points[v]. Taken by value: move them in and they become the
+ *            result's recentred points without a copy.
  */
 Triangulation
-triangulate(const std::vector<Eigen::Vector3d>& points);
+triangulate(std::vector<Eigen::Vector3d> points);
 
 /** \brief A thread count: \a requested, or all processors for 0 (PCL's
  * convention). */
@@ -96,6 +99,9 @@ enum class FacetRole : std::uint8_t {
 struct CellView {
   /** Vertex ids; in dimension 2, v[3] is -1. */
   std::array<int, 4> v;
+  /** Vertex ids of a cell a few visits ahead (-1 if none), for the pass to fetch
+   * its per-vertex records into the cache before it needs them. */
+  std::array<int, 4> ahead;
   /** What a pass asks forEachCell() to compute, besides the vertices and facets. */
   enum Data : unsigned int { CIRCUMCENTER = 1, FACETS = 2, NEIGHBORS = 4 | FACETS };
   /** The circumcenter (the cell's Voronoi vertex), if CIRCUMCENTER was asked. */
