@@ -46,9 +46,9 @@ outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f
 }
 
 /** Gathers VoronoiCells::nearest: per vertex the nearest Delaunay neighbours offered
- * so far (ties by id). Only the distance of the last one kept is stored; the others
- * are recomputed when a new neighbour comes in, which is rare: most offers are of a
- * neighbour too far or already kept, since about ten cells share an edge. */
+ * so far, ties by id, with their squared distances in float beside them (the order
+ * only has to be reproducible). Most offers are of a neighbour too far or already
+ * kept (about ten cells share an edge): both are rejected without a search. */
 class NearestNeighbours {
 public:
   static constexpr int K = VoronoiCells::NEAREST;
@@ -61,7 +61,9 @@ public:
     std::array<int, K> none;
     none.fill(-1);
     ids_.assign(P_.size(), none);
-    worst_.assign(P_.size(), std::numeric_limits<float>::infinity());
+    std::array<float, K> far;
+    far.fill(std::numeric_limits<float>::infinity());
+    d2_.assign(P_.size(), far);
   }
 
   /** Squared length of the edge vw, as the lists compare it: the same bits from
@@ -69,8 +71,7 @@ public:
   float
   distance2(int v, int w) const
   {
-    return w < 0 ? std::numeric_limits<float>::infinity()
-                 : static_cast<float>((P_[w] - P_[v]).squaredNorm());
+    return static_cast<float>((P_[w] - P_[v]).squaredNorm());
   }
 
   /** Offer w, joined to v by a Delaunay edge of squared length d2, to the list of
@@ -78,7 +79,8 @@ public:
   void
   offer(int v, int w, float d2)
   {
-    if (d2 > worst_[v])
+    auto& d2s = d2_[v];
+    if (d2 > d2s[K - 1])
       return;
     auto& ids = ids_[v];
     bool kept = false; // one vector compare
@@ -87,17 +89,16 @@ public:
     if (kept)
       return;
     int k = K;
-    for (; k > 0; --k) {
-      const float d2k = distance2(v, ids[k - 1]);
-      if (!(d2 < d2k || (d2 == d2k && w < ids[k - 1])))
-        break;
-    }
+    while (k > 0 && (d2 < d2s[k - 1] || (d2 == d2s[k - 1] && w < ids[k - 1])))
+      --k;
     if (k == K)
       return;
-    for (int j = K - 1; j > k; --j)
+    for (int j = K - 1; j > k; --j) {
+      d2s[j] = d2s[j - 1];
       ids[j] = ids[j - 1];
+    }
+    d2s[k] = d2;
     ids[k] = w;
-    worst_[v] = distance2(v, ids[K - 1]);
   }
 
   /** Fetch the list of v into the cache. */
@@ -106,20 +107,21 @@ public:
   {
     __builtin_prefetch(&ids_[v].front()); // a list may straddle two cache lines
     __builtin_prefetch(&ids_[v].back());
-    __builtin_prefetch(&worst_[v]);
+    __builtin_prefetch(&d2_[v].front());
+    __builtin_prefetch(&d2_[v].back());
   }
 
   /** Free the distances; the lists stay. */
   void
   release()
   {
-    std::vector<float>().swap(worst_);
+    std::vector<std::array<float, K>>().swap(d2_);
   }
 
 private:
   const std::vector<Eigen::Vector3d>& P_;
   std::vector<std::array<int, K>>& ids_;
-  std::vector<float> worst_;
+  std::vector<std::array<float, K>> d2_;
 };
 
 /** Coplanar points: every Voronoi cell is a prism over the planar Voronoi polygon. */
@@ -177,32 +179,14 @@ planarCells(const Triangulation& dt, double cocone_angle)
   return vc;
 }
 
-/** Bits of a non-negative double: they order as the values do (+inf included). */
-std::uint64_t
-bitsOf(double x)
-{
-  std::uint64_t b;
-  std::memcpy(&b, &x, sizeof(b));
-  return b;
-}
-
-double
-doubleOf(std::uint64_t b)
-{
-  double x;
-  std::memcpy(&x, &b, sizeof(x));
-  return x;
-}
-
-/** Raise *target to x (x >= 0) atomically. */
+/** Raise *target to x atomically. */
 void
-atomicMax(std::uint64_t* target, double x)
+atomicMax(double* target, double x)
 {
-  const std::uint64_t bits = bitsOf(x);
-  std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
-  while (bits > seen &&
-         !__atomic_compare_exchange_n(
-             target, &seen, bits, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  double seen;
+  __atomic_load(target, &seen, __ATOMIC_RELAXED);
+  while (x > seen && !__atomic_compare_exchange(
+                         target, &seen, &x, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
   }
 }
 
@@ -372,7 +356,11 @@ computeVoronoiCells(const Triangulation& dt,
   // atomic updates and each thread collects its triangles; the sort below fixes
   // their order.
   const double cos_angle = std::cos(cocone_angle);
-  std::vector<std::uint64_t> neg2(n, 0), width(n, 0); // bits of non-negative doubles
+  // The squared distance to v- and the width are raised in place.
+  std::vector<double>& neg2 = vc.height_minus;
+  std::vector<double>& width = vc.width;
+  neg2.assign(n, 0.0);
+  width.assign(n, 0.0);
   std::vector<std::uint8_t> met(n, 0);
   // Chunked, so that collecting them never holds two copies (no reallocation).
   std::vector<std::deque<CoconeTriangle>> found(threads);
@@ -428,9 +416,8 @@ computeVoronoiCells(const Triangulation& dt,
                     found[thread].push_back({f, meets});
                 }
               });
-  vc.height_minus.resize(n);
   for (std::size_t v = 0; v < n; ++v)
-    vc.height_minus[v] = std::sqrt(doubleOf(neg2[v]));
+    vc.height_minus[v] = std::sqrt(neg2[v]);
   // An unbounded Voronoi edge going to the negative side puts v- at infinity.
   for (const auto& h : hull) {
     const Eigen::Vector3d normal = hullNormal(h);
@@ -446,10 +433,10 @@ computeVoronoiCells(const Triangulation& dt,
   for (auto& t : found)
     for (; !t.empty(); t.pop_front()) // frees each chunk once copied
       vc.triangles.push_back(t.front());
-  vc.width.resize(n);
   // A co-cone that meets no Voronoi edge tells nothing about flatness: not flat.
   for (std::size_t v = 0; v < n; ++v)
-    vc.width[v] = met[v] ? doubleOf(width[v]) : INF;
+    if (!met[v])
+      vc.width[v] = INF;
   std::sort(vc.triangles.begin(),
             vc.triangles.end(),
             [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
