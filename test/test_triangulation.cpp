@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <random>
 
 using namespace pcl::cocone;
 
@@ -102,6 +103,36 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
     EXPECT_EQ(4 * cells, hull + 2 * own);
     EXPECT_GT(hull, 0u);
   }
+}
+
+TEST(Triangulate, SameCellsWhateverTheThreads)
+{
+  // Large enough for the concurrent insertion; half the points on a grid, where
+  // nearly every cell has co-spherical neighbours and only CGAL's symbolic
+  // perturbation makes the triangulation unique.
+  std::vector<Eigen::Vector3d> P;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j)
+      for (int k = 0; k < 40; ++k)
+        P.emplace_back(i, j, k);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> u(0.0, 39.0);
+  for (int i = 0; i < 40000; ++i)
+    P.emplace_back(u(random), u(random), u(random));
+  const auto cells = [&](unsigned int threads) {
+    const Triangulation dt = triangulate(makeUniquePoints(P).points, threads);
+    std::vector<std::array<int, 4>> out;
+    forEachCell(dt, 0, 1, [&](const CellView& c, int) {
+      auto v = c.v;
+      std::sort(v.begin(), v.end());
+      out.push_back(v);
+    });
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  const auto sequential = cells(1);
+  EXPECT_GT(sequential.size(), 5 * P.size());
+  EXPECT_EQ(cells(2), sequential);
 }
 
 TEST(Triangulate, RecentresLargeCoordinates)

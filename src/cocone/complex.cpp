@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "radix_sort.h"
+#include "edge_sort.h"
 
 #include <algorithm>
 #include <cmath>
@@ -50,7 +50,7 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
     }
   }
   // Generated in triangle order: a stable sort by key keeps it within each edge.
-  detail::radixSortByKey(inc);
+  detail::sortByEdgeKey(inc);
   triangle_edges_.resize(m);
   edge_first_.push_back(0);
   edge_triangles_.reserve(inc.size());

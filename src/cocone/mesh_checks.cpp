@@ -5,7 +5,7 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
-#include "radix_sort.h"
+#include "edge_sort.h"
 
 #include <algorithm>
 #include <numeric>
@@ -60,7 +60,7 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
           {std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), a < b});
     }
   // Generated in triangle order: a stable sort by key keeps it within each edge.
-  detail::radixSortByKey(items);
+  detail::sortByEdgeKey(items);
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (i == 0 || items[i].key != items[i - 1].key) {
       first.push_back(i);

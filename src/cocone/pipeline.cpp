@@ -92,13 +92,9 @@ reconstruct(Triangulation& dt,
   }
   counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size());
   // A canonical order: the same input gives the same mesh, whatever the walk order.
-  std::sort(result.triangles.begin(), result.triangles.end(), [](auto a, auto b) {
-    std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
-    std::rotate(b.begin(), std::min_element(b.begin(), b.end()), b.end());
-    return a < b;
-  });
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  std::sort(result.triangles.begin(), result.triangles.end());
 
   // Normals: the pole line, turned to the side the mesh faces. At an undersampled
   // point the pole says little (at a border it leans towards the convex hull): there
@@ -145,7 +141,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
     return result;
   }
 
-  Triangulation dt = triangulate(std::move(unique.points));
+  Triangulation dt = triangulate(std::move(unique.points), parameters.threads);
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";

@@ -136,9 +136,7 @@ orient(const std::vector<Eigen::Vector3d>& P,
   // the mesh cannot be oriented (a fold that a walk left near a border) the
   // disagreement then lands on the fold's own edges, not on a seam wherever two
   // fronts of a breadth-first pass happen to meet.
-  std::vector<Eigen::Vector3d> normal(m);
-  for (std::size_t t = 0; t < m; ++t)
-    normal[t] = unitNormal(P, triangles[t]);
+  std::vector<Eigen::Vector3d> normal; // of the triangles grown in Prim's order
   std::vector<int> component(m, -1), order(m, -1);
   std::vector<std::uint8_t> drop(m, 0);
   std::vector<int> members;
@@ -160,13 +158,61 @@ orient(const std::vector<Eigen::Vector3d>& P,
       heap.emplace(agree, -t2, -t);
     }
   };
+  // A component that can be oriented has one orientation given its seed's: a
+  // breadth-first pass finds it, and only where it meets a disagreement does the
+  // order matter and the pass run again in Prim's order.
+  const auto across = [&](int t, int e) {
+    const std::size_t i = inc.first[e];
+    return inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
+  };
+  const auto disagree = [&](int t, int t2, int e) {
+    return traverses_forward(t, e) == traverses_forward(t2, e);
+  };
+  std::vector<std::uint8_t> turned(m, 0);
   for (std::size_t s = 0; s < m; ++s, members.clear()) {
     if (component[s] >= 0)
       continue;
     component[s] = c;
-    order[s] = rank++;
     members.push_back(static_cast<int>(s));
-    offer(static_cast<int>(s));
+    for (std::size_t q = 0; q < members.size(); ++q) {
+      const int t = members[q];
+      for (const int e : tri_edges[t]) {
+        if (inc.count(e) != 2)
+          continue;
+        const int t2 = across(t, e);
+        if (component[t2] >= 0)
+          continue;
+        component[t2] = c;
+        members.push_back(t2);
+        if (disagree(t, t2, e)) {
+          std::swap(triangles[t2][1], triangles[t2][2]);
+          turned[t2] = 1;
+        }
+      }
+    }
+    bool consistent = true;
+    for (std::size_t q = 0; q < members.size() && consistent; ++q)
+      for (const int e : tri_edges[members[q]])
+        if (inc.count(e) == 2 && disagree(members[q], across(members[q], e), e))
+          consistent = false;
+    if (consistent) {
+      for (const int t : members)
+        flipped += turned[t];
+    }
+    else {
+      normal.resize(m);
+      for (const int t : members) {
+        if (turned[t])
+          std::swap(triangles[t][1], triangles[t][2]);
+        component[t] = -1;
+        normal[t] = unitNormal(P, triangles[t]);
+      }
+      members.clear();
+      component[s] = c;
+      order[s] = rank++;
+      members.push_back(static_cast<int>(s));
+      offer(static_cast<int>(s));
+    }
     while (!heap.empty()) {
       const int t2 = -std::get<1>(heap.top()), t = -std::get<2>(heap.top());
       heap.pop();

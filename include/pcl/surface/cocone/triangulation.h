@@ -73,12 +73,19 @@ struct Triangulation {
 
 /** \brief Triangulate unique points (stage 1).
  *
+ * With several threads the points are inserted concurrently (CGAL's parallel
+ * Delaunay triangulation, cells locked through a grid over the bounding box). The
+ * Delaunay triangulation of a point set is unique (CGAL's symbolic perturbation
+ * settles co-spherical points by the points alone), so the cells are the same
+ * whatever the thread count; only their order in memory differs, which no pass
+ * depends on.
  * \param[in] points unique points (see makeUniquePoints); vertex v of the result
  *            is points[v]. Taken by value: move them in and they become the
  *            result's recentred points without a copy.
+ * \param[in] num_threads threads to use, 0 for all processors
  */
 Triangulation
-triangulate(std::vector<Eigen::Vector3d> points);
+triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads = 1);
 
 /** \brief A thread count: \a requested, or all processors for 0 (PCL's
  * convention). */
