@@ -7,6 +7,7 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/repair.h>
 
 #include <gtest/gtest.h>
 
@@ -298,6 +299,56 @@ TEST(Reconstruction, NoisyClosedSurface)
   const Outcome run = reconstruct(s);
   EXPECT_LE(run.mesh.loops, 5u);
   EXPECT_GE(run.mesh.used_share, 0.95);
+}
+
+TEST(Repair, FilledHolesLeaveAnOrientedManifold)
+{
+  // A bumpy 12 x 12 grid sheet, two triangles per square, oriented alike.
+  const int side = 12;
+  std::vector<Eigen::Vector3d> P;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j)
+      P.emplace_back(i, j, 0.2 * std::sin(0.7 * i) * std::cos(0.5 * j));
+  const auto id = [&](int i, int j) { return i * side + j; };
+  std::vector<pcl::cocone::Triangle> all;
+  for (int i = 0; i + 1 < side; ++i)
+    for (int j = 0; j + 1 < side; ++j) {
+      all.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      all.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  std::vector<pcl::cocone::Triangle> allowed = all;
+  for (auto& t : allowed)
+    std::sort(t.begin(), t.end());
+  std::sort(allowed.begin(), allowed.end());
+  // Holes: one triangle (3 edges), one square (4 edges), and the six triangles
+  // around vertex (7, 7) (6 edges, but no allowed triangle spans it: stays open).
+  const auto has = [](const pcl::cocone::Triangle& t, int v) {
+    return std::find(t.begin(), t.end(), v) != t.end();
+  };
+  std::vector<pcl::cocone::Triangle> mesh;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const auto& t = all[k];
+    const bool one = k == 2 * (2 * (side - 1) + 2);  // square (2, 2)
+    const bool square = k / 2 == 4 * (side - 1) + 6; // square (4, 6)
+    const bool fan = has(t, id(7, 7));               // around (7, 7)
+    if (!one && !square && !fan)
+      mesh.push_back(t);
+  }
+  // As in the pipeline: repaired (here: turned to face outward), then filled.
+  pcl::cocone::RepairCounts counts;
+  pcl::cocone::repairManifold(P, mesh, counts);
+  EXPECT_EQ(counts.dropped(), 0u);
+  counts = {};
+  EXPECT_EQ(pcl::cocone::fillHoles(P, mesh, allowed, 6), 3u);
+  const auto topology = pcl::cocone::analyzeMesh(mesh, P.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(pcl::cocone::boundaryLoops(mesh, P.size()).size(), 2u); // outer, (7, 7)
+  // A repair finds nothing left to do.
+  const auto filled = mesh;
+  pcl::cocone::repairManifold(P, mesh, counts);
+  EXPECT_EQ(mesh, filled);
+  EXPECT_EQ(counts.dropped(), 0u);
+  EXPECT_EQ(counts.flipped, 0u);
 }
 
 TEST(Reconstruction, Deterministic)

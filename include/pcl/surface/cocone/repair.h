@@ -64,8 +64,9 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
  * On noisy samples most spurious holes are one missing triangle. Each loop is
  * triangulated with the least total perimeter among the triangulations whose
  * triangles are all allowed and add no edge the mesh already has; a loop without
- * one stays open. The mesh must be a 2-manifold; repairManifold() should run again
- * afterwards.
+ * one stays open. The mesh must be an oriented 2-manifold, as repairManifold()
+ * leaves it; it stays one (each hole is a simple loop, as every vertex has one fan,
+ * and its triangles run against the loop), so no repair is needed afterwards.
  * \return the number of triangles added
  */
 std::size_t
