@@ -9,6 +9,7 @@
 #include <CGAL/spatial_sort.h>
 
 #include "delaunay.h"
+#include "memory.h"
 #include "points.h"
 #include <tbb/scalable_allocator.h>
 #include <tbb/task_arena.h>
@@ -17,9 +18,6 @@
 #endif
 
 #include <algorithm>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -369,15 +367,11 @@ Triangulation::release()
   structure.reset();
   // TBB's allocator keeps freed blocks for reuse; hand them back too.
   scalable_allocation_command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
-#ifdef __GLIBC__
-  // The cells were allocated by the thread that built them, in a malloc arena of
-  // its own, which worker threads reuse later; a small block of theirs left on top
-  // of a heap keeps glibc from unmapping the freed cells, and the later stages
-  // then take new memory from the main arena (measured: peak 1.41 GB instead of
-  // 0.96 GB on a million saddle points with two threads). Trimming releases the
-  // free pages of every arena.
-  malloc_trim(0);
-#endif
+  // And glibc's: what the builder thread allocated lies in a malloc arena of its
+  // own, which worker threads reuse later; a small block left on top of a heap
+  // keeps glibc from unmapping the rest (measured before the cells came from TBB:
+  // peak 1.41 GB instead of 0.96 GB on a million saddle points, two threads).
+  detail::releaseFreedMemory();
 }
 
 int

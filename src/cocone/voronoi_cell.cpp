@@ -5,12 +5,12 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
+#include "memory.h"
 #include "points.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <deque>
+#include <mutex>
 
 namespace pcl {
 namespace cocone {
@@ -311,6 +311,7 @@ computeVoronoiCells(const Triangulation& dt,
   });
   std::vector<std::uint8_t>().swap(lock);
   nearest.release();
+  detail::releaseFreedMemory(); // pass 2 and stage 3 are the peak of the pipeline
 
   // The pole of a vertex on the convex hull: the sum of the outward normals of its
   // hull facets, added in facet order so that the sum is reproducible. (A sampled
@@ -362,8 +363,17 @@ computeVoronoiCells(const Triangulation& dt,
   neg2.assign(n, 0.0);
   width.assign(n, 0.0);
   std::vector<std::uint8_t> met(n, 0);
-  // Chunked, so that collecting them never holds two copies (no reallocation).
-  std::vector<std::deque<CoconeTriangle>> found(threads);
+  // Collected straight into the result, a batch per thread at a time: a sampled
+  // surface has about two per point, which the reservation mostly holds, and no
+  // second copy of them is ever made.
+  vc.triangles.reserve(n * 9 / 4);
+  std::vector<std::vector<CoconeTriangle>> batch(threads);
+  std::mutex appending;
+  const auto append = [&](int thread) {
+    const std::lock_guard<std::mutex> lock(appending);
+    vc.triangles.insert(vc.triangles.end(), batch[thread].begin(), batch[thread].end());
+    batch[thread].clear();
+  };
   forEachCell(dt,
               CellView::CIRCUMCENTER | CellView::NEIGHBORS,
               threads,
@@ -412,8 +422,11 @@ computeVoronoiCells(const Triangulation& dt,
                         __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
                     }
                   }
-                  if (meets)
-                    found[thread].push_back({f, meets});
+                  if (meets) {
+                    batch[thread].push_back({f, meets});
+                    if (batch[thread].size() == 4096)
+                      append(thread);
+                  }
                 }
               });
   for (std::size_t v = 0; v < n; ++v)
@@ -426,13 +439,8 @@ computeVoronoiCells(const Triangulation& dt,
         vc.height_minus[h[k]] = INF;
   }
 
-  std::size_t total = 0;
-  for (const auto& t : found)
-    total += t.size();
-  vc.triangles.reserve(total);
-  for (auto& t : found)
-    for (; !t.empty(); t.pop_front()) // frees each chunk once copied
-      vc.triangles.push_back(t.front());
+  for (int thread = 0; thread < threads; ++thread)
+    append(thread);
   // A co-cone that meets no Voronoi edge tells nothing about flatness: not flat.
   for (std::size_t v = 0; v < n; ++v)
     if (!met[v])
