@@ -152,19 +152,42 @@ runStages(const std::vector<Eigen::Vector3d>& points,
   }
   result.offset = dt.offset;
 
-  VoronoiCells cells =
-      computeVoronoiCells(dt, parameters.cocone_angle, parameters.threads);
+  VoronoiCells cells = computePoles(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
+
+  // Stage 3 in two parts: what reads the nearest neighbours (the local spacing and
+  // the half-disk test, which need only the poles) before the second Voronoi pass,
+  // whose peak memory then does not hold the neighbour lists; the flatness test
+  // after it.
+  const bool detect = parameters.boundary_detection;
+  const bool half_disk = detect && parameters.gap_angle > 0.0;
+  const std::vector<double> spacing =
+      detect && (parameters.spacing_factor > 0.0 || half_disk)
+          ? localSpacing(dt.points, cells)
+          : std::vector<double>();
+  HalfDisk test;
+  if (half_disk)
+    test = halfDiskTest(dt.points,
+                        cells,
+                        spacing,
+                        parameters.gap_reach,
+                        parameters.gap_angle,
+                        resolveThreads(parameters.threads));
+  std::vector<std::array<int, VoronoiCells::NEAREST>>().swap(cells.nearest);
+  result.timings.boundary = clock.lap();
+
+  computeCocones(dt, parameters.cocone_angle, parameters.threads, cells);
+  // Only the paper's literal candidate rule reads the cells again.
+  if (stages != Stages::RECONSTRUCTION ||
+      parameters.candidate_rule != CandidateRule::LITERAL)
+    dt.release();
+  result.timings.voronoi += clock.lap();
 
   result.boundary.assign(result.vertices, 0);
   // Per vertex: for a rim vertex the longest edge at it of a triangle it may choose
   // (its local spacing), infinite for the others; empty without the half-disk test.
   std::vector<double> rim_reach;
-  if (parameters.boundary_detection) {
-    const bool half_disk = parameters.gap_angle > 0.0;
-    const std::vector<double> spacing = parameters.spacing_factor > 0.0 || half_disk
-                                            ? localSpacing(dt.points, cells)
-                                            : std::vector<double>();
+  if (detect) {
     const BoundaryLabels labels = detectBoundary(
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
@@ -173,12 +196,6 @@ runStages(const std::vector<Eigen::Vector3d>& points,
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];
     if (half_disk) {
-      const HalfDisk test = halfDiskTest(dt.points,
-                                         cells,
-                                         spacing,
-                                         parameters.gap_reach,
-                                         parameters.gap_angle,
-                                         resolveThreads(parameters.threads));
       rim_reach.assign(result.vertices, std::numeric_limits<double>::infinity());
       for (std::size_t v = 0; v < result.vertices; ++v)
         if (!result.boundary[v] && test.rim[v]) {
@@ -187,14 +204,10 @@ runStages(const std::vector<Eigen::Vector3d>& points,
         }
     }
   }
-  // Stage 3 was the last to read the neighbour lists: make room for stage 4.
-  std::vector<std::array<int, VoronoiCells::NEAREST>>().swap(cells.nearest);
-  result.timings.boundary = clock.lap();
+  result.timings.boundary += clock.lap();
 
   result.umbrella_failed.assign(result.vertices, 0);
-  if (stages != Stages::RECONSTRUCTION)
-    dt.release();
-  else {
+  if (stages == Stages::RECONSTRUCTION) {
     reconstruct(dt, cells, parameters, rim_reach, result);
     result.timings.reconstruction = clock.lap();
   }

@@ -256,6 +256,14 @@ computeVoronoiCells(const Triangulation& dt,
                     double cocone_angle,
                     unsigned int num_threads)
 {
+  VoronoiCells vc = computePoles(dt, cocone_angle, num_threads);
+  computeCocones(dt, cocone_angle, num_threads, vc);
+  return vc;
+}
+
+VoronoiCells
+computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_threads)
+{
   if (dt.dimension == 2 && dt.number_of_cells > 0)
     return planarCells(dt, cocone_angle);
   VoronoiCells vc;
@@ -348,8 +356,20 @@ computeVoronoiCells(const Triangulation& dt,
       far[v].setZero();
     }
   }
-  std::vector<int>().swap(slot);
-  std::vector<Eigen::Vector3d>().swap(sum);
+  return vc;
+}
+
+void
+computeCocones(const Triangulation& dt,
+               double cocone_angle,
+               unsigned int num_threads,
+               VoronoiCells& vc)
+{
+  if (dt.dimension != 3)
+    return; // done in one pass with the poles (dimension 2), or nothing to do
+  const auto& P = dt.points;
+  const std::size_t n = P.size();
+  const int threads = resolveThreads(num_threads);
 
   // Pass 2: the negative pole (the farthest Voronoi vertex on the other side of p),
   // then the width and the co-cone triangles over the Voronoi edges, i.e. over the
@@ -398,8 +418,14 @@ computeVoronoiCells(const Triangulation& dt,
                   const auto f = facetIds(cell.v, i);
                   Eigen::Vector3d a = cc, d;
                   const bool ray = cell.facet[i] == FacetRole::HULL;
-                  if (ray)
+                  if (ray) {
                     d = outwardNormal(P, f, cell.v[i]);
+                    // An unbounded Voronoi edge going to the negative side puts
+                    // v- at infinity.
+                    for (const int v : f)
+                      if (d.dot(vc.pole[v]) < 0.0)
+                        atomicMax(&neg2[v], INF);
+                  }
                   else {
                     // Orient the segment canonically so the test is bitwise
                     // reproducible.
@@ -431,13 +457,6 @@ computeVoronoiCells(const Triangulation& dt,
               });
   for (std::size_t v = 0; v < n; ++v)
     vc.height_minus[v] = std::sqrt(neg2[v]);
-  // An unbounded Voronoi edge going to the negative side puts v- at infinity.
-  for (const auto& h : hull) {
-    const Eigen::Vector3d normal = hullNormal(h);
-    for (int k = 0; k < 3; ++k)
-      if (normal.dot(vc.pole[h[k]]) < 0.0)
-        vc.height_minus[h[k]] = INF;
-  }
 
   for (int thread = 0; thread < threads; ++thread)
     append(thread);
@@ -448,7 +467,6 @@ computeVoronoiCells(const Triangulation& dt,
   std::sort(vc.triangles.begin(),
             vc.triangles.end(),
             [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
-  return vc;
 }
 
 } // namespace cocone

@@ -98,7 +98,35 @@ intersectCocone(const Eigen::Vector3d& p,
                 const Eigen::Vector3d& d,
                 bool ray);
 
-/** \brief Compute poles, heights, widths and the co-cone triangles (stage 2).
+/** \brief Stage 2, first pass over the cells: the poles, h+, the convex-hull flags
+ * and the nearest Delaunay neighbours (in dimension 2, the whole of stage 2).
+ *
+ * Stage 3 reads the neighbour lists; it can run before computeCocones(), so that
+ * the lists are freed before the second pass, the peak of the pipeline.
+ * \param[in] dt the triangulation (dimension 2 or 3)
+ * \param[in] cocone_angle the co-cone angle in radians (used in dimension 2 only)
+ * \param[in] num_threads threads to use, 0 for all processors
+ */
+VoronoiCells
+computePoles(const Triangulation& dt,
+             double cocone_angle,
+             unsigned int num_threads = 1);
+
+/** \brief Stage 2, second pass: h-, the co-cone widths and the co-cone triangles,
+ * from the poles of computePoles().
+ * \param[in] dt the triangulation computePoles() read
+ * \param[in] cocone_angle the co-cone angle in radians (3 pi / 8 in the paper)
+ * \param[in] num_threads threads to use, 0 for all processors
+ * \param[in,out] cells the result of computePoles(), completed
+ */
+void
+computeCocones(const Triangulation& dt,
+               double cocone_angle,
+               unsigned int num_threads,
+               VoronoiCells& cells);
+
+/** \brief Compute poles, heights, widths and the co-cone triangles (stage 2):
+ * computePoles() then computeCocones().
  *
  * The result does not depend on the number of threads.
  * \param[in] dt the triangulation (dimension 2 or 3)
