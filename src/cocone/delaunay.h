@@ -13,6 +13,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
+#include <memory>
 #include <vector>
 
 namespace pcl {
@@ -25,19 +26,51 @@ using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
 /** Cells as CGAL's default: the circumcenters are recomputed where a pass needs
  * them, which is cheaper than the memory to keep them (about 19 cells per point). */
 using CellBase = CGAL::Delaunay_triangulation_cell_base_3<Kernel>;
-/** The concurrent structure, also when built sequentially: it builds as fast with
- * one thread and takes less memory (TBB's allocator). */
-using Tds =
-    CGAL::Triangulation_data_structure_3<VertexBase, CellBase, CGAL::Parallel_tag>;
-using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
+template <typename ConcurrencyTag>
+using DelaunayOf = CGAL::Delaunay_triangulation_3<
+    Kernel,
+    CGAL::Triangulation_data_structure_3<VertexBase, CellBase, ConcurrencyTag>>;
+/** Built by one thread: CGAL's sequential structure, which builds fastest so. */
+using SequentialDelaunay = DelaunayOf<CGAL::Sequential_tag>;
+/** Built by several threads (points inserted concurrently, cells locked). */
+using ParallelDelaunay = DelaunayOf<CGAL::Parallel_tag>;
 
-struct DelaunayStructure {
+/** A triangulation and the order in which the passes visit its cells. */
+template <typename Delaunay>
+struct Built {
   Delaunay dt;
-  /** The finite cells in the order the passes visit them: by smallest vertex id.
-   * CGAL's container reuses freed slots, so its order scatters neighbouring cells;
-   * in this order the cells across a cell's facets and the per-vertex records of
-   * its vertices are mostly still in cache. */
-  std::vector<Delaunay::Cell_handle> cells;
+  /** The finite cells by smallest vertex id. CGAL's container reuses freed slots,
+   * so its order scatters neighbouring cells; in this order the cells across a
+   * cell's facets and the per-vertex records of its vertices are mostly still in
+   * cache. */
+  std::vector<typename Delaunay::Cell_handle> cells;
+};
+
+/** One of the two, as the thread count chose. */
+struct DelaunayStructure {
+  std::unique_ptr<Built<SequentialDelaunay>> sequential;
+  std::unique_ptr<Built<ParallelDelaunay>> parallel;
+
+  /** Call f on the one that is built. */
+  template <typename F>
+  void
+  visit(F&& f) const
+  {
+    if (sequential)
+      f(static_cast<const Built<SequentialDelaunay>&>(*sequential));
+    else
+      f(static_cast<const Built<ParallelDelaunay>&>(*parallel));
+  }
+
+  template <typename F>
+  void
+  visit(F&& f)
+  {
+    if (sequential)
+      f(*sequential);
+    else
+      f(*parallel);
+  }
 };
 
 } // namespace detail

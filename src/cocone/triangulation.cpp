@@ -27,6 +27,7 @@
 #include <new>
 #include <numeric>
 #include <thread>
+#include <type_traits>
 #include <utility>
 
 namespace pcl {
@@ -34,7 +35,6 @@ namespace cocone {
 
 namespace {
 
-using detail::Delaunay;
 using detail::isFinite;
 using detail::Kernel;
 using detail::lexLess;
@@ -158,14 +158,16 @@ triangleCircumcenter(const Eigen::Vector3d& a,
 namespace {
 
 /** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
+template <typename Delaunay>
 int
 cornersOf(const Delaunay& dt)
 {
   return dt.dimension() == 3 ? 4 : 3;
 }
 
+template <typename Delaunay>
 bool
-isFiniteCell(const Delaunay& dt, Delaunay::Cell_handle c)
+isFiniteCell(const Delaunay& dt, typename Delaunay::Cell_handle c)
 {
   for (int i = 0, corners = cornersOf(dt); i < corners; ++i)
     if (dt.is_infinite(c->vertex(i)))
@@ -175,8 +177,9 @@ isFiniteCell(const Delaunay& dt, Delaunay::Cell_handle c)
 
 /** The circumcenter of a finite cell, from its vertices in ascending id order (a
  * canonical order: the result is bitwise reproducible). */
+template <typename Delaunay>
 Eigen::Vector3d
-circumcenterOf(const Delaunay& dt, Delaunay::Cell_handle c)
+circumcenterOf(const Delaunay& dt, typename Delaunay::Cell_handle c)
 {
   // The points are read from CGAL's vertices, which are loaded for their ids
   // anyway; they hold the same recentred coordinates as Triangulation::points.
@@ -198,10 +201,11 @@ circumcenterOf(const Delaunay& dt, Delaunay::Cell_handle c)
 /** Fill structure.cells: the finite cells by their smallest vertex id, in buckets
  * of 64 ids (a few hundred cells: a counting sort with few write positions; inside
  * a bucket the container's order, which does not matter). */
+template <typename Built>
 void
-orderCells(detail::DelaunayStructure& structure, std::size_t number_of_vertices)
+orderCells(Built& structure, std::size_t number_of_vertices)
 {
-  const Delaunay& dt = structure.dt;
+  const auto& dt = structure.dt;
   const int corners = cornersOf(dt);
   std::vector<int> key;
   key.reserve(dt.tds().number_of_cells());
@@ -227,10 +231,11 @@ orderCells(detail::DelaunayStructure& structure, std::size_t number_of_vertices)
 }
 
 /** Run body(cell, thread) over the finite cells, split in equal runs per thread. */
-template <typename Body>
+template <typename Built, typename Body>
 void
-splitCells(const detail::DelaunayStructure& structure, int threads, const Body& body)
+splitCells(const Built& structure, int threads, const Body& body)
 {
+  using Cell_handle = typename decltype(Built::dt)::Cell_handle;
   constexpr std::size_t AHEAD = 8;
   const int corners = cornersOf(structure.dt);
   // An exception must not leave a parallel region: it is caught in the thread and
@@ -262,7 +267,7 @@ splitCells(const detail::DelaunayStructure& structure, int threads, const Body& 
             __builtin_prefetch(&*c->vertex(i));
         }
         body(structure.cells[k],
-             k + AHEAD < end ? structure.cells[k + AHEAD] : Delaunay::Cell_handle(),
+             k + AHEAD < end ? structure.cells[k + AHEAD] : Cell_handle(),
              thread);
       }
     }
@@ -309,15 +314,17 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
           Kernel,
           CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
   out.structure = std::make_shared<detail::DelaunayStructure>();
-  Delaunay& dt = out.structure->dt;
   const int threads = resolveThreads(num_threads);
   // Concurrent insertion pays off only on large clouds; the grid of 100^3 locks
   // was the fastest measured on a million points (10^3: blocked most of the time).
+  // One thread builds CGAL's sequential structure, which is faster so.
   const bool concurrent = threads > 1 && sites.size() >= 100000;
-  CGAL::Bbox_3 box;
-  for (const auto& site : sites)
-    box += site.first.bbox();
-  std::unique_ptr<Delaunay::Lock_data_structure> locks;
+  if (concurrent)
+    out.structure->parallel =
+        std::make_unique<detail::Built<detail::ParallelDelaunay>>();
+  else
+    out.structure->sequential =
+        std::make_unique<detail::Built<detail::SequentialDelaunay>>();
   // CGAL's insertion keeps scratch tables in thread-local storage that an exception
   // (std::bad_alloc) leaves dirty, which breaks every later insertion in the same
   // thread. Building in a thread of its own confines that state to this call.
@@ -325,14 +332,19 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
   std::thread builder([&]() {
     try {
       if (concurrent) {
-        locks = std::make_unique<Delaunay::Lock_data_structure>(box, 100);
-        dt.set_lock_data_structure(locks.get());
+        auto& dt = out.structure->parallel->dt;
+        CGAL::Bbox_3 box;
+        for (const auto& site : sites)
+          box += site.first.bbox();
+        detail::ParallelDelaunay::Lock_data_structure locks(box, 100);
+        dt.set_lock_data_structure(&locks);
         tbb::task_arena arena(threads);
         arena.execute([&]() { dt.insert(sites.begin(), sites.end()); });
         dt.set_lock_data_structure(nullptr);
       }
       else {
-        Delaunay::Vertex_handle hint;
+        auto& dt = out.structure->sequential->dt;
+        detail::SequentialDelaunay::Vertex_handle hint;
         for (const auto& site : sites) {
           hint = dt.insert(site.first, hint);
           hint->info() = site.second;
@@ -344,18 +356,20 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
     }
   });
   builder.join();
-  locks.reset();
   if (failure)
     std::rethrow_exception(failure);
   std::vector<std::pair<Kernel::Point_3, int>>().swap(sites);
-  out.dimension = dt.dimension();
+  out.structure->visit(
+      [&](const auto& built) { out.dimension = built.dt.dimension(); });
   if (out.dimension < 2) {
     out.release();
     return out;
   }
 
-  orderCells(*out.structure, out.points.size());
-  out.number_of_cells = out.structure->cells.size();
+  out.structure->visit([&](auto& built) {
+    orderCells(built, out.points.size());
+    out.number_of_cells = built.cells.size();
+  });
   return out;
 }
 
@@ -391,22 +405,24 @@ hullFacets(const Triangulation& triangulation)
   std::vector<std::array<int, 4>> out;
   if (!triangulation.structure || triangulation.dimension != 3)
     return out;
-  const Delaunay& dt = triangulation.structure->dt;
-  std::vector<Delaunay::Cell_handle> outside;
-  dt.incident_cells(dt.infinite_vertex(), std::back_inserter(outside));
-  for (const auto c : outside) {
-    // The finite facet of an infinite cell, and the vertex across it.
-    const int i = c->index(dt.infinite_vertex());
-    const auto inside = c->neighbor(i);
-    const int j = inside->index(c);
-    std::array<int, 4> f;
-    for (int k = 0, m = 0; k < 4; ++k)
-      if (k != j)
-        f[m++] = inside->vertex(k)->info();
-    std::sort(f.begin(), f.begin() + 3);
-    f[3] = inside->vertex(j)->info();
-    out.push_back(f);
-  }
+  triangulation.structure->visit([&](const auto& built) {
+    const auto& dt = built.dt;
+    std::vector<typename std::remove_reference_t<decltype(dt)>::Cell_handle> outside;
+    dt.incident_cells(dt.infinite_vertex(), std::back_inserter(outside));
+    for (const auto c : outside) {
+      // The finite facet of an infinite cell, and the vertex across it.
+      const int i = c->index(dt.infinite_vertex());
+      const auto inside = c->neighbor(i);
+      const int j = inside->index(c);
+      std::array<int, 4> f;
+      for (int k = 0, m = 0; k < 4; ++k)
+        if (k != j)
+          f[m++] = inside->vertex(k)->info();
+      std::sort(f.begin(), f.begin() + 3);
+      f[3] = inside->vertex(j)->info();
+      out.push_back(f);
+    }
+  });
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -422,73 +438,72 @@ visitCells(const Triangulation& triangulation,
 {
   if (!triangulation.structure)
     return;
-  const Delaunay& dt = triangulation.structure->dt;
-  const int corners = cornersOf(dt);
-  // A small direct-mapped cache of circumcenters per thread: the cells across a
-  // cell's facets were mostly created, and are visited, close to it, and computing
-  // a circumcenter again costs mainly the cache misses of loading that cell.
-  constexpr int CACHE_BITS = 14;
-  struct Entry {
-    const void* cell = nullptr;
-    Eigen::Vector3d circumcenter;
-  };
-  std::vector<std::vector<Entry>> caches(
-      threads,
-      std::vector<Entry>(data & CellView::CIRCUMCENTER ? std::size_t(1) << CACHE_BITS
-                                                       : 0));
-  const auto cached = [&](std::vector<Entry>& cache, Delaunay::Cell_handle c) {
-    const auto key = reinterpret_cast<std::uintptr_t>(&*c);
-    Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
-    if (e.cell != &*c) {
-      e.cell = &*c;
-      e.circumcenter = circumcenterOf(dt, c);
-    }
-    return e.circumcenter;
-  };
-  splitCells(*triangulation.structure,
-             threads,
-             [&](Delaunay::Cell_handle c, Delaunay::Cell_handle ahead, int thread) {
-               auto& cache = caches[thread];
-               CellView view;
-               view.corners = corners;
-               view.v = {-1, -1, -1, -1};
-               view.ahead = {-1, -1, -1, -1};
-               for (int i = 0; i < corners; ++i) {
-                 view.v[i] = c->vertex(i)->info();
-                 if (ahead != Delaunay::Cell_handle())
-                   view.ahead[i] = ahead->vertex(i)->info();
-               }
-               if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS &&
-                   ahead != Delaunay::Cell_handle())
-                 for (int i = 0; i < corners; ++i) {
-                   const char* other =
-                       reinterpret_cast<const char*>(&*ahead->neighbor(i));
-                   __builtin_prefetch(other);
-                   __builtin_prefetch(other + 64);
-                 }
-               if (data & CellView::CIRCUMCENTER)
-                 view.circumcenter = cached(cache, c);
-               for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
-                 if (i >= corners) {
-                   view.facet[i] = FacetRole::HULL;
-                   continue;
-                 }
-                 const auto other = c->neighbor(i);
-                 // Each interior facet once: from the cell at the higher address
-                 // (which one does not matter to the visitors; both are visited
-                 // close together, so the other's circumcenter is mostly cached).
-                 if (!isFiniteCell(dt, other))
-                   view.facet[i] = FacetRole::HULL;
-                 else if (&*other > &*c)
-                   view.facet[i] = FacetRole::SHARED;
-                 else {
-                   view.facet[i] = FacetRole::OWN;
-                   if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS)
-                     view.neighbor_circumcenter[i] = cached(cache, other);
-                 }
-               }
-               visitor(context, view, thread);
-             });
+  triangulation.structure->visit([&](const auto& built) {
+    const auto& dt = built.dt;
+    using Cell_handle = typename std::remove_reference_t<decltype(dt)>::Cell_handle;
+    const int corners = cornersOf(dt);
+    // A small direct-mapped cache of circumcenters per thread: the cells across a
+    // cell's facets were mostly created, and are visited, close to it, and computing
+    // a circumcenter again costs mainly the cache misses of loading that cell.
+    constexpr int CACHE_BITS = 14;
+    struct Entry {
+      const void* cell = nullptr;
+      Eigen::Vector3d circumcenter;
+    };
+    std::vector<std::vector<Entry>> caches(
+        threads,
+        std::vector<Entry>(data & CellView::CIRCUMCENTER ? std::size_t(1) << CACHE_BITS
+                                                         : 0));
+    const auto cached = [&](std::vector<Entry>& cache, Cell_handle c) {
+      const auto key = reinterpret_cast<std::uintptr_t>(&*c);
+      Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
+      if (e.cell != &*c) {
+        e.cell = &*c;
+        e.circumcenter = circumcenterOf(dt, c);
+      }
+      return e.circumcenter;
+    };
+    splitCells(built, threads, [&](Cell_handle c, Cell_handle ahead, int thread) {
+      auto& cache = caches[thread];
+      CellView view;
+      view.corners = corners;
+      view.v = {-1, -1, -1, -1};
+      view.ahead = {-1, -1, -1, -1};
+      for (int i = 0; i < corners; ++i) {
+        view.v[i] = c->vertex(i)->info();
+        if (ahead != Cell_handle())
+          view.ahead[i] = ahead->vertex(i)->info();
+      }
+      if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS && ahead != Cell_handle())
+        for (int i = 0; i < corners; ++i) {
+          const char* other = reinterpret_cast<const char*>(&*ahead->neighbor(i));
+          __builtin_prefetch(other);
+          __builtin_prefetch(other + 64);
+        }
+      if (data & CellView::CIRCUMCENTER)
+        view.circumcenter = cached(cache, c);
+      for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
+        if (i >= corners) {
+          view.facet[i] = FacetRole::HULL;
+          continue;
+        }
+        const auto other = c->neighbor(i);
+        // Each interior facet once: from the cell at the higher address
+        // (which one does not matter to the visitors; both are visited
+        // close together, so the other's circumcenter is mostly cached).
+        if (!isFiniteCell(dt, other))
+          view.facet[i] = FacetRole::HULL;
+        else if (&*other > &*c)
+          view.facet[i] = FacetRole::SHARED;
+        else {
+          view.facet[i] = FacetRole::OWN;
+          if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS)
+            view.neighbor_circumcenter[i] = cached(cache, other);
+        }
+      }
+      visitor(context, view, thread);
+    });
+  });
 }
 
 } // namespace detail
