@@ -5,7 +5,6 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
-#include "memory.h"
 #include "points.h"
 
 #include <algorithm>
@@ -319,7 +318,6 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
   });
   std::vector<std::uint8_t>().swap(lock);
   nearest.release();
-  detail::releaseFreedMemory(); // pass 2 and stage 3 are the peak of the pipeline
 
   // The pole of a vertex on the convex hull: the sum of the outward normals of its
   // hull facets, added in facet order so that the sum is reproducible. (A sampled
