@@ -361,6 +361,13 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
   if (failure)
     std::rethrow_exception(failure);
   std::vector<std::pair<Kernel::Point_3, int>>().swap(sites);
+  // The scratch the insertion freed lies in the builder's (and TBB's workers') malloc
+  // arenas, which glibc keeps mapped: hand it back before the passes add their
+  // arrays on top (measured peak on a million saddle points: 1005 -> 962 MB with two
+  // threads, 945 -> 928 MB with one).
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
   out.structure->visit(
       [&](const auto& built) { out.dimension = built.dt.dimension(); });
   if (out.dimension < 2) {
