@@ -23,6 +23,7 @@
 #include <new>
 #include <string>
 #include <system_error>
+#include <utility>
 
 namespace pcl {
 namespace cocone {
@@ -124,7 +125,7 @@ reconstruct(Triangulation& dt,
 }
 
 Result
-runStages(const std::vector<Eigen::Vector3d>& points,
+runStages(std::vector<Eigen::Vector3d>&& points,
           const Parameters& parameters,
           Stages stages,
           const std::vector<int>& ids)
@@ -135,6 +136,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
     return ids.empty() ? static_cast<int>(i) : ids[i];
   };
   UniquePoints unique = makeUniquePoints(points);
+  std::vector<Eigen::Vector3d>().swap(points); // the unique points stand in for them
   result.vertex_of_input = std::move(unique.vertex_of_input);
   result.vertices = unique.points.size();
   result.timings.unique = clock.lap();
@@ -214,7 +216,7 @@ runStages(const std::vector<Eigen::Vector3d>& points,
 
   // Back to the caller's ids.
   result.representative.assign(result.vertices, std::numeric_limits<int>::max());
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  for (std::size_t i = 0; i < result.vertex_of_input.size(); ++i) {
     const int v = result.vertex_of_input[i];
     if (v < 0)
       continue;
@@ -239,19 +241,20 @@ runStages(const std::vector<Eigen::Vector3d>& points,
 } // namespace
 
 Result
-run(const std::vector<Eigen::Vector3d>& points,
+run(std::vector<Eigen::Vector3d> points,
     const Parameters& parameters,
     Stages stages,
     const std::vector<int>& ids)
 {
   // Running out of memory is an outcome to report, not a reason to terminate the
   // caller's process (a scanning pipeline keeps running with an empty result).
+  const std::size_t count = points.size();
   try {
-    return runStages(points, parameters, stages, ids);
+    return runStages(std::move(points), parameters, stages, ids);
   }
   catch (const std::bad_alloc&) {
     Result failed;
-    failed.error = "out of memory for " + std::to_string(points.size()) + " points";
+    failed.error = "out of memory for " + std::to_string(count) + " points";
     return failed;
   }
   catch (const std::system_error& e) { // no thread could be started

@@ -118,14 +118,15 @@ enum class Stages { BOUNDARY_DETECTION, RECONSTRUCTION };
 
 /** \brief Run the stages on a set of points.
  *
- * \param[in] points the points; non-finite points and duplicates are allowed
+ * \param[in] points the points; non-finite points and duplicates are allowed (taken
+ *            by value: move them in, they are freed once the unique points are made)
  * \param[in] parameters the parameters
  * \param[in] stages how far to go
  * \param[in] ids the caller's id of each point (e.g. its index in a PCL cloud);
  *            empty: the position in \a points
  */
 Result
-run(const std::vector<Eigen::Vector3d>& points,
+run(std::vector<Eigen::Vector3d> points,
     const Parameters& parameters,
     Stages stages,
     const std::vector<int>& ids = {});

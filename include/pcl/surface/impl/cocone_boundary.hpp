@@ -121,7 +121,8 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
     ids_.push_back(static_cast<int>(i));
   }
 
-  result_ = cocone::run(points, parameters_, stages, ids_);
+  const std::size_t count = points.size();
+  result_ = cocone::run(std::move(points), parameters_, stages, ids_);
   timings_ = result_.timings;
   if (!result_.error.empty()) {
     PCL_ERROR("[pcl::%s::%s] No result: %s.\n",
@@ -136,7 +137,7 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
             "rho %.3f; %zu boundary points, %zu triangles.\n",
             getClassName().c_str(),
             caller,
-            points.size(),
+            count,
             result_.vertices,
             timings_.unique,
             timings_.delaunay,
