@@ -5,9 +5,8 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
-#include "edge_sort.h"
-
 #include <algorithm>
+#include <cstdint>
 #include <numeric>
 
 namespace pcl {
@@ -46,31 +45,55 @@ struct DisjointSets {
 
 EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
 {
-  struct Item {
-    std::uint64_t key;
-    int t;
-    bool forward;
-  };
-  std::vector<Item> items;
-  items.reserve(3 * oriented.size());
-  for (std::size_t t = 0; t < oriented.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t a = oriented[t][k], b = oriented[t][(k + 1) % 3];
-      items.push_back(
-          {std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), a < b});
-    }
-  // Generated in triangle order: a stable sort by key keeps it within each edge.
-  detail::sortByEdgeKey(items);
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i == 0 || items[i].key != items[i - 1].key) {
-      first.push_back(i);
-      edges.push_back({static_cast<int>(items[i].key >> 32),
-                       static_cast<int>(items[i].key & 0xffffffffu)});
-    }
-    triangle.push_back(items[i].t);
-    forward.push_back(items[i].forward);
+  // A counting sort of the incidences by the lower end point, each packed in one
+  // word as (higher end point, triangle, direction): sorting a bucket by the word
+  // orders it by edge, then by triangle.
+  const std::size_t m = oriented.size();
+  int highest = -1;
+  for (const auto& t : oriented)
+    highest = std::max({highest, t[0], t[1], t[2]});
+  std::vector<std::uint32_t> start(static_cast<std::size_t>(highest) + 2, 0);
+  for (const auto& t : oriented)
+    for (int k = 0; k < 3; ++k)
+      ++start[std::min(t[k], t[(k + 1) % 3]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint64_t> word(3 * m);
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t t = 0; t < m; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint64_t a = oriented[t][k], b = oriented[t][(k + 1) % 3];
+        word[fill[std::min(a, b)]++] = std::max(a, b) << 32 | t << 1 | (a < b);
+      }
   }
-  first.push_back(items.size());
+  std::size_t count = 0;
+  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
+    // Buckets hold a handful of incidences: insertion sort.
+    for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
+      const std::uint64_t w = word[i];
+      std::size_t j = i;
+      for (; j > start[v] && word[j - 1] > w; --j)
+        word[j] = word[j - 1];
+      word[j] = w;
+    }
+    for (std::size_t i = start[v]; i < start[v + 1]; ++i)
+      count += i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
+  }
+  edges.reserve(count);
+  first.reserve(count + 1);
+  triangle.resize(3 * m);
+  forward.resize(3 * m);
+  for (std::size_t v = 0; v + 1 < start.size(); ++v)
+    for (std::size_t i = start[v]; i < start[v + 1]; ++i) {
+      const int other = static_cast<int>(word[i] >> 32);
+      if (i == start[v] || other != static_cast<int>(word[i - 1] >> 32)) {
+        first.push_back(i);
+        edges.push_back({static_cast<int>(v), other});
+      }
+      triangle[i] = static_cast<int>((word[i] & 0xffffffffu) >> 1);
+      forward[i] = word[i] & 1u;
+    }
+  first.push_back(3 * m);
 }
 
 std::vector<int>
