@@ -59,20 +59,27 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
   {
     std::vector<int> ring;
     std::vector<double> angles;
+    // Per vertex, the last p whose ring took it: each once, without sorting.
+    std::vector<int> taken(n, -1);
 #pragma omp for schedule(dynamic, 1024)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
-      const std::size_t p = i;
+      const int p = static_cast<int>(i);
       // The one-ring alone leaves gaps of up to 120 degrees inside an even sample
       // (an obtuse Delaunay triangle at p); the two-ring closes them.
       ring.assign(nearest[p].begin(), nearest[p].begin() + degree[p]);
+      taken[p] = p;
+      for (const int q : ring)
+        taken[q] = p;
       for (int k = 0; k < degree[p]; ++k) {
         const int q = nearest[p][k];
-        for (int j = 0; j < degree[q]; ++j)
-          if (nearest[q][j] != static_cast<int>(p) && near(p, nearest[q][j]))
-            ring.push_back(nearest[q][j]);
+        for (int j = 0; j < degree[q]; ++j) {
+          const int r = nearest[q][j];
+          if (taken[r] != p && near(p, r)) {
+            taken[r] = p;
+            ring.push_back(r);
+          }
+        }
       }
-      std::sort(ring.begin(), ring.end());
-      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
       if (ring.size() < 2)
         continue;
       const Eigen::Vector3d& pole = cells.pole[p];
