@@ -18,8 +18,13 @@ namespace {
 struct DisjointSets {
   std::vector<int> parent;
 
-  explicit DisjointSets(std::size_t n) : parent(n)
+  explicit DisjointSets(std::size_t n = 0) { reset(n); }
+
+  /** n singletons again, reusing the storage. */
+  void
+  reset(std::size_t n)
   {
+    parent.resize(n);
     std::iota(parent.begin(), parent.end(), 0);
   }
 
@@ -119,11 +124,13 @@ vertexFans(const std::vector<Triangle>& oriented,
   if (fans_per_vertex)
     fans_per_vertex->assign(num_vertices, 0);
   std::vector<std::pair<int, int>> others; // (other vertex, local corner)
+  DisjointSets sets;
+  std::vector<int> id;
   for (std::size_t v = 0; v < num_vertices; ++v) {
     const int first = corner_first[v], size = corner_first[v + 1] - first;
     if (size == 0)
       continue;
-    DisjointSets sets(size);
+    sets.reset(size);
     others.clear();
     for (int i = 0; i < size; ++i) {
       const int c = corners[first + i], t = c / 3, k = c % 3;
@@ -134,7 +141,7 @@ vertexFans(const std::vector<Triangle>& oriented,
     for (std::size_t j = 1; j < others.size(); ++j)
       if (others[j].first == others[j - 1].first)
         sets.unite(others[j].second, others[j - 1].second);
-    std::vector<int> id(size, -1);
+    id.assign(size, -1);
     int fans = 0;
     for (int i = 0; i < size; ++i) {
       const int r = sets.find(i);

@@ -120,21 +120,30 @@ walk(const TriangleComplex& complex,
   // vertices the surface uses yet: a component joined to another by stray
   // candidate triangles that the walk does not cross still gets its own walk.
   std::vector<std::uint8_t> used(complex.points().size(), 0);
+  const auto free = [&](int t) {
+    const auto& v = complex.triangle(t);
+    return !in_surface[t] && !used[v[0]] && !used[v[1]] && !used[v[2]];
+  };
+  // Gathered once the component walks are done: a triangle not free then never
+  // becomes free (the surface and its vertices only grow), and mostly none is.
   std::vector<int> reseeds;
-  for (int t = 0; t < m; ++t)
-    if (present[t])
-      reseeds.push_back(t);
-  std::stable_sort(reseeds.begin(), reseeds.end(), [&](int a, int b) {
-    return score(a) > score(b);
-  });
+  bool gathered = false;
   std::size_t next_component = 0, next_reseed = 0;
   const auto next_seed = [&]() {
     if (next_component < seeds.size())
       return seeds[next_component++];
+    if (!gathered) {
+      gathered = true;
+      for (int t = 0; t < m; ++t)
+        if (present[t] && free(t))
+          reseeds.push_back(t);
+      std::stable_sort(reseeds.begin(), reseeds.end(), [&](int a, int b) {
+        return score(a) > score(b);
+      });
+    }
     for (; next_reseed < reseeds.size(); ++next_reseed) {
       const int t = reseeds[next_reseed];
-      const auto& v = complex.triangle(t);
-      if (!in_surface[t] && !used[v[0]] && !used[v[1]] && !used[v[2]]) {
+      if (free(t)) {
         ++out.reseeds;
         return t;
       }
