@@ -305,22 +305,24 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
     const auto& p = out.points[i];
     sites.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), static_cast<int>(i));
   }
-  // CGAL's spatial sort (Hilbert order with random rounds, seeded) and insertion
-  // with the previous vertex as the hint: what range insertion does, minus its
-  // indirection through an index array. CGAL's symbolic perturbation makes the
-  // triangulation of degenerate (co-spherical) input independent of the order.
-  CGAL::spatial_sort(
-      sites.begin(),
-      sites.end(),
-      CGAL::Spatial_sort_traits_adapter_3<
-          Kernel,
-          CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
   out.structure = std::make_shared<detail::DelaunayStructure>();
   const int threads = resolveThreads(num_threads);
   // Concurrent insertion pays off only on large clouds; the grid of 100^3 locks
   // was the fastest measured on a million points (10^3: blocked most of the time).
   // One thread builds CGAL's sequential structure, which is faster so.
   const bool concurrent = threads > 1 && sites.size() >= 100000;
+  // One thread: CGAL's spatial sort (Hilbert order with random rounds, seeded) and
+  // insertion with the previous vertex as the hint, what range insertion does minus
+  // its indirection through an index array. Several: CGAL's range insertion, which
+  // sorts in parallel itself. CGAL's symbolic perturbation makes the triangulation
+  // of degenerate (co-spherical) input independent of the order.
+  if (!concurrent)
+    CGAL::spatial_sort(
+        sites.begin(),
+        sites.end(),
+        CGAL::Spatial_sort_traits_adapter_3<
+            Kernel,
+            CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
   if (concurrent)
     out.structure->parallel =
         std::make_unique<detail::Built<detail::ParallelDelaunay>>();
