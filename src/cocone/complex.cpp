@@ -26,12 +26,15 @@ largestAngularGap(std::vector<double>& angles)
 }
 
 TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
-                                 std::vector<Triangle> triangles)
+                                 std::vector<Triangle> triangles,
+                                 int threads)
 : points_(points), triangles_(std::move(triangles))
 {
   for (auto& t : triangles_)
     std::sort(t.begin(), t.end());
-  std::sort(triangles_.begin(), triangles_.end());
+  // The candidates arrive sorted: check before sorting.
+  if (!std::is_sorted(triangles_.begin(), triangles_.end()))
+    std::sort(triangles_.begin(), triangles_.end());
   const std::size_t m = triangles_.size();
 
   // Edges: sort (edge key, triangle, slot) once.
@@ -69,7 +72,9 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Angles about each edge in a frame of the edge.
   edge_angles_.resize(inc.size());
-  for (std::size_t e = 0; e < edges_.size(); ++e) {
+  const auto num_edges = static_cast<std::ptrdiff_t>(edges_.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 4096)
+  for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
     const Eigen::Vector3d& a = points_[edges_[e][0]];
     const Eigen::Vector3d d = (points_[edges_[e][1]] - a).normalized();
     int axis = 0;

@@ -104,7 +104,8 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
 std::vector<int>
 vertexFans(const std::vector<Triangle>& oriented,
            std::size_t num_vertices,
-           std::vector<int>* fans_per_vertex)
+           std::vector<int>* fans_per_vertex,
+           int threads)
 {
   // Corners (t, k) sorted by vertex; two corners of a vertex share a fan when their
   // triangles share an edge at the vertex.
@@ -123,34 +124,38 @@ vertexFans(const std::vector<Triangle>& oriented,
   std::vector<int> fan(3 * m, -1);
   if (fans_per_vertex)
     fans_per_vertex->assign(num_vertices, 0);
-  std::vector<std::pair<int, int>> others; // (other vertex, local corner)
-  DisjointSets sets;
-  std::vector<int> id;
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    const int first = corner_first[v], size = corner_first[v + 1] - first;
-    if (size == 0)
-      continue;
-    sets.reset(size);
-    others.clear();
-    for (int i = 0; i < size; ++i) {
-      const int c = corners[first + i], t = c / 3, k = c % 3;
-      others.emplace_back(oriented[t][(k + 1) % 3], i);
-      others.emplace_back(oriented[t][(k + 2) % 3], i);
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<std::pair<int, int>> others; // (other vertex, local corner)
+    DisjointSets sets;
+    std::vector<int> id;
+#pragma omp for schedule(dynamic, 4096)
+    for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(num_vertices); ++v) {
+      const int first = corner_first[v], size = corner_first[v + 1] - first;
+      if (size == 0)
+        continue;
+      sets.reset(size);
+      others.clear();
+      for (int i = 0; i < size; ++i) {
+        const int c = corners[first + i], t = c / 3, k = c % 3;
+        others.emplace_back(oriented[t][(k + 1) % 3], i);
+        others.emplace_back(oriented[t][(k + 2) % 3], i);
+      }
+      std::sort(others.begin(), others.end());
+      for (std::size_t j = 1; j < others.size(); ++j)
+        if (others[j].first == others[j - 1].first)
+          sets.unite(others[j].second, others[j - 1].second);
+      id.assign(size, -1);
+      int fans = 0;
+      for (int i = 0; i < size; ++i) {
+        const int r = sets.find(i);
+        if (id[r] < 0)
+          id[r] = fans++;
+        fan[corners[first + i]] = id[r];
+      }
+      if (fans_per_vertex)
+        (*fans_per_vertex)[v] = fans;
     }
-    std::sort(others.begin(), others.end());
-    for (std::size_t j = 1; j < others.size(); ++j)
-      if (others[j].first == others[j - 1].first)
-        sets.unite(others[j].second, others[j - 1].second);
-    id.assign(size, -1);
-    int fans = 0;
-    for (int i = 0; i < size; ++i) {
-      const int r = sets.find(i);
-      if (id[r] < 0)
-        id[r] = fans++;
-      fan[corners[first + i]] = id[r];
-    }
-    if (fans_per_vertex)
-      (*fans_per_vertex)[v] = fans;
   }
   return fan;
 }

@@ -59,11 +59,12 @@ reconstruct(Triangulation& dt,
       cells, result.boundary, parameters.candidate_rule, &dt, rim_reach);
   counts.candidates = candidates.size();
   dt.release(); // the cells are no longer needed: make room for stages 5-7
-  const TriangleComplex complex(dt.points, candidates);
+  const int threads = resolveThreads(parameters.threads);
+  const TriangleComplex complex(dt.points, candidates, threads);
 
   std::vector<std::uint8_t> umbrella_triangles;
   result.umbrella_failed =
-      umbrellaFailures(complex, result.boundary, &umbrella_triangles);
+      umbrellaFailures(complex, result.boundary, &umbrella_triangles, threads);
   std::vector<std::uint8_t> boundary = result.boundary;
   for (std::size_t v = 0; v < boundary.size(); ++v)
     if (result.umbrella_failed[v]) {
@@ -80,7 +81,7 @@ reconstruct(Triangulation& dt,
   counts.walk_reseeds = walked.reseeds;
 
   result.triangles = std::move(walked.triangles);
-  repairManifold(dt.points, result.triangles, counts.repair);
+  repairManifold(dt.points, result.triangles, counts.repair, threads);
   if (parameters.fill_hole_edges >= 3) {
     std::vector<Triangle> delaunay;
     delaunay.reserve(cells.triangles.size());

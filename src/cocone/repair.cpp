@@ -76,10 +76,10 @@ resolveEdges(const std::vector<Eigen::Vector3d>& P,
 
 /** At every vertex with several fans keep the largest. */
 std::size_t
-resolveVertices(std::vector<Triangle>& triangles, std::size_t num_vertices)
+resolveVertices(std::vector<Triangle>& triangles, std::size_t num_vertices, int threads)
 {
   std::vector<int> fans;
-  const std::vector<int> fan = vertexFans(triangles, num_vertices, &fans);
+  const std::vector<int> fan = vertexFans(triangles, num_vertices, &fans, threads);
   std::vector<int> size_first(num_vertices + 1, 0);
   for (std::size_t v = 0; v < num_vertices; ++v)
     size_first[v + 1] = size_first[v] + fans[v];
@@ -268,7 +268,8 @@ orient(const std::vector<Eigen::Vector3d>& P,
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
-               RepairCounts& counts)
+               RepairCounts& counts,
+               int threads)
 {
   for (;;) {
     const EdgeIncidences inc(triangles);
@@ -276,7 +277,7 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
       counts.nonmanifold_edge += d;
       continue;
     }
-    if (const std::size_t d = resolveVertices(triangles, points.size())) {
+    if (const std::size_t d = resolveVertices(triangles, points.size(), threads)) {
       counts.nonmanifold_vertex += d;
       continue;
     }

@@ -62,20 +62,23 @@ hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* ke
   if (kept)
     for (std::size_t i = 0; i < star.size(); ++i)
       if (!removed[i])
-        ++(*kept)[star[i]];
+        __atomic_fetch_add(&(*kept)[star[i]], 1, __ATOMIC_RELAXED); // stars overlap
   return true;
 }
 
 std::vector<std::uint8_t>
 umbrellaFailures(const TriangleComplex& complex,
                  const std::vector<std::uint8_t>& boundary,
-                 std::vector<std::uint8_t>* umbrella_triangles)
+                 std::vector<std::uint8_t>* umbrella_triangles,
+                 int threads)
 {
   std::vector<std::uint8_t> failed(boundary.size(), 0);
   std::vector<std::uint8_t> kept;
   if (umbrella_triangles)
     kept.assign(complex.numTriangles(), 0);
-  for (std::size_t p = 0; p < boundary.size(); ++p)
+  const auto n = static_cast<std::ptrdiff_t>(boundary.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
+  for (std::ptrdiff_t p = 0; p < n; ++p)
     if (!boundary[p])
       failed[p] = !hasUmbrella(
           complex, static_cast<int>(p), umbrella_triangles ? &kept : nullptr);

@@ -25,9 +25,11 @@ using Triangle = std::array<int, 3>;
 class TriangleComplex {
 public:
   /** \param[in] points vertex positions
-   *  \param[in] triangles the triangles (any vertex order; duplicates not allowed) */
+   *  \param[in] triangles the triangles (any vertex order; duplicates not allowed)
+   *  \param[in] threads threads for the angles about the edges */
   TriangleComplex(const std::vector<Eigen::Vector3d>& points,
-                  std::vector<Triangle> triangles);
+                  std::vector<Triangle> triangles,
+                  int threads = 1);
 
   /** Number of triangles. */
   std::size_t

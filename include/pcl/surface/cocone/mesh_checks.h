@@ -38,13 +38,15 @@ struct EdgeIncidences {
 /** \brief Per vertex, the fans of its star: groups of triangles connected through
  * edges at the vertex. A 2-manifold has one fan per vertex.
  *
+ * \param[in] threads threads to go through the vertices with
  * \return per triangle corner (3 t + k): the fan id of vertex oriented[t][k] that the
  *         triangle belongs to, numbered from 0 per vertex
  */
 std::vector<int>
 vertexFans(const std::vector<Triangle>& oriented,
            std::size_t num_vertices,
-           std::vector<int>* fans_per_vertex = nullptr);
+           std::vector<int>* fans_per_vertex = nullptr,
+           int threads = 1);
 
 /** \brief Topology of an oriented triangle mesh. */
 struct MeshTopology {

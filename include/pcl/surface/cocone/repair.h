@@ -52,11 +52,13 @@ struct RepairCounts {
  * \param[in] points vertex positions
  * \param[in,out] triangles oriented triangles
  * \param[in,out] counts what was changed (added to)
+ * \param[in] threads threads for the vertex fans
  */
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
-               RepairCounts& counts);
+               RepairCounts& counts,
+               int threads = 1);
 
 /** \brief Close border loops of at most \a max_edges edges by triangles from
  * \a allowed (sorted vertex triples, ascending), oriented with their neighbours.

@@ -31,12 +31,14 @@ hasUmbrella(const TriangleComplex& complex,
  * \param[in] boundary per vertex: in B (these are not checked)
  * \param[out] umbrella_triangles if given, per triangle: it survives in the umbrella
  *             of each of its three vertices (all three checked and passed)
+ * \param[in] threads threads to check the vertices with
  * \return per vertex: failed the umbrella check
  */
 std::vector<std::uint8_t>
 umbrellaFailures(const TriangleComplex& complex,
                  const std::vector<std::uint8_t>& boundary,
-                 std::vector<std::uint8_t>* umbrella_triangles = nullptr);
+                 std::vector<std::uint8_t>* umbrella_triangles = nullptr,
+                 int threads = 1);
 
 } // namespace cocone
 } // namespace pcl
