@@ -163,14 +163,21 @@ vertexFans(const std::vector<Triangle>& oriented,
 std::vector<int>
 triangleComponents(const std::vector<Triangle>& oriented, std::size_t* count)
 {
-  const EdgeIncidences inc(oriented);
-  DisjointSets sets(oriented.size());
+  return triangleComponents(EdgeIncidences(oriented), oriented.size(), count);
+}
+
+std::vector<int>
+triangleComponents(const EdgeIncidences& inc,
+                   std::size_t num_triangles,
+                   std::size_t* count)
+{
+  DisjointSets sets(num_triangles);
   for (std::size_t e = 0; e < inc.edges.size(); ++e)
     for (std::size_t i = inc.first[e] + 1; i < inc.first[e + 1]; ++i)
       sets.unite(inc.triangle[i], inc.triangle[inc.first[e]]);
-  std::vector<int> id(oriented.size(), -1), out(oriented.size());
+  std::vector<int> id(num_triangles, -1), out(num_triangles);
   int n = 0;
-  for (std::size_t t = 0; t < oriented.size(); ++t) {
+  for (std::size_t t = 0; t < num_triangles; ++t) {
     const int r = sets.find(static_cast<int>(t));
     if (id[r] < 0)
       id[r] = n++;
@@ -189,7 +196,7 @@ analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices)
   const EdgeIncidences inc(oriented);
   topo.edges = inc.edges.size();
   std::size_t components = 0;
-  const std::vector<int> comp = triangleComponents(oriented, &components);
+  const std::vector<int> comp = triangleComponents(inc, oriented.size(), &components);
   topo.components = components;
   std::vector<std::uint8_t> open(components, 0);
   for (std::size_t e = 0; e < inc.edges.size(); ++e) {

@@ -307,13 +307,17 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       hole_next[b] = a;
       starts.push_back(b);
     }
+  // The mesh's triangles as sorted triples, made for the first hole to fill (a
+  // closed surface has none, and a border loop is mostly longer than a hole).
   std::vector<Triangle> present;
-  present.reserve(triangles.size());
-  for (auto t : triangles) {
-    std::sort(t.begin(), t.end());
-    present.push_back(t);
-  }
-  std::sort(present.begin(), present.end());
+  const auto make_present = [&]() {
+    present.reserve(triangles.size());
+    for (auto t : triangles) {
+      std::sort(t.begin(), t.end());
+      present.push_back(t);
+    }
+    std::sort(present.begin(), present.end());
+  };
   const auto is_edge = [&](int a, int b) {
     return std::binary_search(inc.edges.begin(),
                               inc.edges.end(),
@@ -338,6 +342,8 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
     const std::size_t k = loop.size();
     if (k < 3 || k > max_edges || hole_next[loop.back()] != x)
       continue;
+    if (present.empty())
+      make_present();
     // The triangulation of the hole's polygon by allowed triangles with the least
     // total perimeter (dynamic programming over the polygon); no new edge may
     // already be in the mesh.
@@ -397,8 +403,8 @@ std::size_t
 dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices)
 {
   std::size_t count = 0;
-  const std::vector<int> component = triangleComponents(triangles, &count);
   const EdgeIncidences inc(triangles);
+  const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
   std::vector<std::uint8_t> on_border(num_vertices, 0);
   for (std::size_t e = 0; e < inc.edges.size(); ++e)
     if (inc.count(e) == 1)

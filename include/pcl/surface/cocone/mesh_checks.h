@@ -90,5 +90,11 @@ borderVertices(const std::vector<Triangle>& triangles);
 std::vector<int>
 triangleComponents(const std::vector<Triangle>& oriented, std::size_t* count = nullptr);
 
+/** \brief The same from the edge incidences of \a num_triangles triangles. */
+std::vector<int>
+triangleComponents(const EdgeIncidences& inc,
+                   std::size_t num_triangles,
+                   std::size_t* count = nullptr);
+
 } // namespace cocone
 } // namespace pcl
