@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <tuple>
 
@@ -74,33 +75,57 @@ resolveEdges(const std::vector<Eigen::Vector3d>& P,
   return any ? compact(triangles, drop) : 0;
 }
 
-/** At every vertex with several fans keep the largest. */
+/** At every vertex with several fans keep the largest; with \a only, at the vertices
+ * it marks (the others' fans are not looked at). The vertices of the dropped
+ * triangles are marked in \a touched. */
 std::size_t
-resolveVertices(std::vector<Triangle>& triangles, std::size_t num_vertices, int threads)
+resolveVertices(std::vector<Triangle>& triangles,
+                std::size_t num_vertices,
+                int threads,
+                const std::vector<std::uint8_t>* only,
+                std::vector<std::uint8_t>& touched)
 {
+  // With \a only: the stars of the marked vertices, by their ids in triangles.
+  std::vector<int> subset;
+  std::vector<Triangle> stars;
+  if (only)
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+      const auto& v = triangles[t];
+      if ((*only)[v[0]] || (*only)[v[1]] || (*only)[v[2]]) {
+        subset.push_back(static_cast<int>(t));
+        stars.push_back(v);
+      }
+    }
+  const std::vector<Triangle>& list = only ? stars : triangles;
+  const auto considered = [&](int v) { return !only || (*only)[v]; };
   std::vector<int> fans;
-  const std::vector<int> fan = vertexFans(triangles, num_vertices, &fans, threads);
+  const std::vector<int> fan = vertexFans(list, num_vertices, &fans, threads);
   std::vector<int> size_first(num_vertices + 1, 0);
   for (std::size_t v = 0; v < num_vertices; ++v)
     size_first[v + 1] = size_first[v] + fans[v];
   std::vector<int> size(size_first.back(), 0);
   for (std::size_t c = 0; c < fan.size(); ++c)
-    ++size[size_first[triangles[c / 3][c % 3]] + fan[c]];
+    ++size[size_first[list[c / 3][c % 3]] + fan[c]];
   std::vector<int> keep(num_vertices, 0);
   bool any = false;
   for (std::size_t v = 0; v < num_vertices; ++v)
-    if (fans[v] > 1) {
+    if (fans[v] > 1 && considered(static_cast<int>(v))) {
       any = true;
       const auto b = size.begin() + size_first[v];
       keep[v] = static_cast<int>(std::max_element(b, b + fans[v]) - b);
     }
+  touched.assign(num_vertices, 0);
   if (!any)
     return 0;
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   for (std::size_t c = 0; c < fan.size(); ++c) {
-    const int v = triangles[c / 3][c % 3];
-    if (fans[v] > 1 && fan[c] != keep[v])
-      drop[c / 3] = 1;
+    const int v = list[c / 3][c % 3];
+    if (fans[v] > 1 && considered(v) && fan[c] != keep[v]) {
+      const std::size_t t = only ? subset[c / 3] : c / 3;
+      drop[t] = 1;
+      for (const int w : triangles[t])
+        touched[w] = 1;
+    }
   }
   return compact(triangles, drop);
 }
@@ -277,11 +302,22 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
       counts.nonmanifold_edge += d;
       continue;
     }
-    if (const std::size_t d = resolveVertices(triangles, points.size(), threads)) {
-      counts.nonmanifold_vertex += d;
-      continue;
+    // Dropping triangles adds no triangle to an edge and changes only the stars of
+    // their vertices: those are checked again until none has several fans.
+    std::vector<std::uint8_t> touched, again;
+    std::size_t dropped = 0;
+    std::size_t d =
+        resolveVertices(triangles, points.size(), threads, nullptr, touched);
+    while (d > 0) {
+      dropped += d;
+      d = resolveVertices(triangles, points.size(), threads, &touched, again);
+      touched.swap(again);
     }
-    const std::size_t d = orient(points, triangles, inc, counts.flipped);
+    counts.nonmanifold_vertex += dropped;
+    std::optional<EdgeIncidences> rebuilt;
+    if (dropped)
+      rebuilt.emplace(triangles);
+    d = orient(points, triangles, rebuilt ? *rebuilt : inc, counts.flipped);
     if (d == 0)
       return;
     counts.orientation += d;
