@@ -199,14 +199,18 @@ orient(const std::vector<Eigen::Vector3d>& P,
       continue;
     component[s] = c;
     members.push_back(static_cast<int>(s));
+    bool consistent = true;
     for (std::size_t q = 0; q < members.size(); ++q) {
       const int t = members[q];
       for (const int e : tri_edges[t]) {
         if (inc.count(e) != 2)
           continue;
         const int t2 = across(t, e);
-        if (component[t2] >= 0)
+        if (component[t2] >= 0) {
+          // Both oriented: each edge inside the component is met so at least once.
+          consistent = consistent && !disagree(t, t2, e);
           continue;
+        }
         component[t2] = c;
         members.push_back(t2);
         if (disagree(t, t2, e)) {
@@ -215,11 +219,6 @@ orient(const std::vector<Eigen::Vector3d>& P,
         }
       }
     }
-    bool consistent = true;
-    for (std::size_t q = 0; q < members.size() && consistent; ++q)
-      for (const int e : tri_edges[members[q]])
-        if (inc.count(e) == 2 && disagree(members[q], across(members[q], e), e))
-          consistent = false;
     if (consistent) {
       for (const int t : members)
         flipped += turned[t];
