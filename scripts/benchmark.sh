@@ -56,8 +56,11 @@ if [[ " ${methods[*]} " == *" ball_pivoting "* ]] &&
   echo "open3d is not importable by $python: no ball pivoting" >&2
   methods=("${methods[@]/ball_pivoting/}")
 fi
-# Open3D and PCL use OpenMP in places; the same number of threads for everyone.
-export OMP_NUM_THREADS=$threads
+# Open3D and PCL use OpenMP in places; the same number of threads for everyone
+# (0, this library's "all cores", is OpenMP's default).
+if [ "$threads" -gt 0 ]; then
+  export OMP_NUM_THREADS=$threads
+fi
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -114,9 +117,9 @@ fi
 
 cat << EOF
 Seconds and peak resident memory (MB) of each process, with ratios to CGAL's Delaunay
-triangulation alone on the same cloud; $threads thread(s). Base MB: the process after
-reading the cloud (libraries, interpreter), included in the peak. Boundary edges: edges
-in one triangle; Euler: V - E + F over the vertices used; border points: reported
+triangulation alone on the same cloud; $threads thread(s) (0: all cores). Base MB:
+the process after reading the cloud (libraries, interpreter), included in the peak.
+Boundary edges: edges in one triangle; Euler: V - E + F over the vertices used; border points: reported
 (of a mesh: the vertices of its boundary edges), with recall and precision where the
 truth is known (torus: none is true; saddle: within 1.5 spacings of the edge; range
 scans: the borders of the grid).
