@@ -37,41 +37,29 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
     std::sort(triangles_.begin(), triangles_.end());
   const std::size_t m = triangles_.size();
 
-  // Edges: sort (edge key, triangle, slot) once.
-  struct Incidence {
-    std::uint64_t key;
-    int t;
-    int k; // the edge is opposite vertex k of t
-  };
-  std::vector<Incidence> inc;
-  inc.reserve(3 * m);
-  for (std::size_t t = 0; t < m; ++t) {
-    const auto& v = triangles_[t];
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t a = v[(k + 1) % 3], b = v[(k + 2) % 3];
-      inc.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<int>(t), k});
-    }
-  }
-  // Generated in triangle order: a stable sort by key keeps it within each edge.
-  detail::sortByEdgeKey(inc);
+  // Edges: the incidences grouped by edge once. Incidence (t, k) runs from corner k
+  // to corner k + 1, so it is the edge opposite corner k + 2.
+  std::vector<std::uint32_t> start;
+  const std::vector<std::uint64_t> word =
+      detail::groupEdgeIncidences(triangles_, start);
   triangle_edges_.resize(m);
-  edge_first_.push_back(0);
-  edge_triangles_.reserve(inc.size());
-  edge_angles_.reserve(inc.size());
-  for (std::size_t i = 0; i < inc.size(); ++i) {
-    if (i > 0 && inc[i].key != inc[i - 1].key)
-      edge_first_.push_back(i);
-    if (i == 0 || inc[i].key != inc[i - 1].key)
-      edges_.push_back({static_cast<int>(inc[i].key >> 32),
-                        static_cast<int>(inc[i].key & 0xffffffffu)});
-    const int e = static_cast<int>(edges_.size()) - 1;
-    triangle_edges_[inc[i].t][inc[i].k] = e;
-    edge_triangles_.push_back(inc[i].t);
-  }
-  edge_first_.push_back(inc.size());
+  edge_triangles_.resize(word.size());
+  for (std::size_t v = 0; v + 1 < start.size(); ++v)
+    for (std::size_t i = start[v]; i < start[v + 1]; ++i) {
+      const int other = static_cast<int>(word[i] >> 32);
+      if (i == start[v] || other != static_cast<int>(word[i - 1] >> 32)) {
+        edge_first_.push_back(i);
+        edges_.push_back({static_cast<int>(v), other});
+      }
+      const int t = static_cast<int>((word[i] & 0xffffffffu) >> 2);
+      triangle_edges_[t][((word[i] & 3u) + 2) % 3] =
+          static_cast<int>(edges_.size()) - 1;
+      edge_triangles_[i] = t;
+    }
+  edge_first_.push_back(word.size());
 
   // Angles about each edge in a frame of the edge.
-  edge_angles_.resize(inc.size());
+  edge_angles_.resize(word.size());
   const auto num_edges = static_cast<std::ptrdiff_t>(edges_.size());
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
   for (std::ptrdiff_t e = 0; e < num_edges; ++e) {

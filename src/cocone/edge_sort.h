@@ -2,54 +2,57 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * Stable sort of edge records by their edge key (not installed).
+ * The edge incidences of a triangle list, grouped by edge (not installed).
  */
 
 #pragma once
 
+#include <pcl/surface/cocone/complex.h>
+
 #include <algorithm>
-#include <array>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
 namespace pcl {
 namespace cocone {
 namespace detail {
 
-/** Sort items by their member `key`, an edge key (lower vertex id << 32 | higher
- * vertex id), stably. A counting sort on the lower id, then insertion sorts inside
- * its buckets, which hold a handful of items each. Edge keys of a triangle list are
- * sorted this way several times per reconstruction: one scattering pass, where a
- * radix sort took four and std::sort's comparisons dominated. */
-template <typename Item>
-void
-sortByEdgeKey(std::vector<Item>& items)
+/** The incidences of the edges of \a triangles grouped by edge. Incidence (t, k) is
+ * the edge from triangles[t][k] to triangles[t][(k + 1) % 3]; it is kept in the
+ * bucket of its lower end point, packed as (higher end point << 32 | t << 2 | k).
+ * Inside a bucket the words are sorted: by edge, then by triangle. A counting sort
+ * on the lower end point, then insertion sorts inside its buckets, which hold a
+ * handful of incidences each: one scattering pass.
+ * \param[out] start per lower end point v, its bucket [start[v], start[v + 1]) */
+inline std::vector<std::uint64_t>
+groupEdgeIncidences(const std::vector<Triangle>& triangles,
+                    std::vector<std::uint32_t>& start)
 {
-  if (items.size() < 2)
-    return;
-  std::uint64_t highest = 0;
-  for (const auto& it : items)
-    highest = std::max(highest, it.key >> 32);
-  std::vector<std::size_t> first(highest + 2, 0);
-  for (const auto& it : items)
-    ++first[(it.key >> 32) + 1];
-  for (std::size_t v = 1; v < first.size(); ++v)
-    first[v] += first[v - 1];
-  std::vector<Item> sorted(items.size());
-  {
-    std::vector<std::size_t> fill(first.begin(), first.end() - 1);
-    for (const auto& it : items)
-      sorted[fill[it.key >> 32]++] = it;
-  }
-  for (std::size_t v = 0; v + 1 < first.size(); ++v)
-    for (std::size_t i = first[v] + 1; i < first[v + 1]; ++i) {
-      const Item it = sorted[i];
-      std::size_t j = i;
-      for (; j > first[v] && sorted[j - 1].key > it.key; --j)
-        sorted[j] = sorted[j - 1];
-      sorted[j] = it;
+  int highest = -1;
+  for (const auto& t : triangles)
+    highest = std::max({highest, t[0], t[1], t[2]});
+  start.assign(static_cast<std::size_t>(highest) + 2, 0);
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      ++start[std::min(t[k], t[(k + 1) % 3]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint64_t> word(3 * triangles.size());
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::uint64_t k = 0; k < 3; ++k) {
+      const std::uint64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      word[fill[std::min(a, b)]++] = std::max(a, b) << 32 | t << 2 | k;
     }
-  items.swap(sorted);
+  for (std::size_t v = 0; v + 1 < start.size(); ++v)
+    for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
+      const std::uint64_t w = word[i];
+      std::size_t j = i;
+      for (; j > start[v] && word[j - 1] > w; --j)
+        word[j] = word[j - 1];
+      word[j] = w;
+    }
+  return word;
 }
 
 } // namespace detail

@@ -5,6 +5,8 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
+#include "edge_sort.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
@@ -50,44 +52,16 @@ struct DisjointSets {
 
 EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
 {
-  // A counting sort of the incidences by the lower end point, each packed in one
-  // word as (higher end point, triangle, direction): sorting a bucket by the word
-  // orders it by edge, then by triangle.
-  const std::size_t m = oriented.size();
-  int highest = -1;
-  for (const auto& t : oriented)
-    highest = std::max({highest, t[0], t[1], t[2]});
-  std::vector<std::uint32_t> start(static_cast<std::size_t>(highest) + 2, 0);
-  for (const auto& t : oriented)
-    for (int k = 0; k < 3; ++k)
-      ++start[std::min(t[k], t[(k + 1) % 3]) + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::uint64_t> word(3 * m);
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t t = 0; t < m; ++t)
-      for (int k = 0; k < 3; ++k) {
-        const std::uint64_t a = oriented[t][k], b = oriented[t][(k + 1) % 3];
-        word[fill[std::min(a, b)]++] = std::max(a, b) << 32 | t << 1 | (a < b);
-      }
-  }
+  std::vector<std::uint32_t> start;
+  const std::vector<std::uint64_t> word = detail::groupEdgeIncidences(oriented, start);
   std::size_t count = 0;
-  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
-    // Buckets hold a handful of incidences: insertion sort.
-    for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
-      const std::uint64_t w = word[i];
-      std::size_t j = i;
-      for (; j > start[v] && word[j - 1] > w; --j)
-        word[j] = word[j - 1];
-      word[j] = w;
-    }
+  for (std::size_t v = 0; v + 1 < start.size(); ++v)
     for (std::size_t i = start[v]; i < start[v + 1]; ++i)
       count += i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
-  }
   edges.reserve(count);
   first.reserve(count + 1);
-  triangle.resize(3 * m);
-  forward.resize(3 * m);
+  triangle.resize(word.size());
+  forward.resize(word.size());
   for (std::size_t v = 0; v + 1 < start.size(); ++v)
     for (std::size_t i = start[v]; i < start[v + 1]; ++i) {
       const int other = static_cast<int>(word[i] >> 32);
@@ -95,10 +69,10 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
         first.push_back(i);
         edges.push_back({static_cast<int>(v), other});
       }
-      triangle[i] = static_cast<int>((word[i] & 0xffffffffu) >> 1);
-      forward[i] = word[i] & 1u;
+      triangle[i] = static_cast<int>((word[i] & 0xffffffffu) >> 2);
+      forward[i] = static_cast<int>(v) == oriented[triangle[i]][word[i] & 3u];
     }
-  first.push_back(3 * m);
+  first.push_back(word.size());
 }
 
 std::vector<int>

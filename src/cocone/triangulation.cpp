@@ -159,6 +159,17 @@ triangleCircumcenter(const Eigen::Vector3d& a,
 
 namespace {
 
+/** Hand glibc's free memory back to the system. What the builder thread and TBB's
+ * workers allocated lies in malloc arenas of their own, which glibc keeps mapped
+ * after it is freed (a small block left on top of a heap keeps the rest too). */
+void
+trimMallocArenas()
+{
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
 /** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
 template <typename Delaunay>
 int
@@ -316,19 +327,19 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
   // its indirection through an index array. Several: CGAL's range insertion, which
   // sorts in parallel itself. CGAL's symbolic perturbation makes the triangulation
   // of degenerate (co-spherical) input independent of the order.
-  if (!concurrent)
+  if (concurrent)
+    out.structure->parallel =
+        std::make_unique<detail::Built<detail::ParallelDelaunay>>();
+  else {
     CGAL::spatial_sort(
         sites.begin(),
         sites.end(),
         CGAL::Spatial_sort_traits_adapter_3<
             Kernel,
             CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
-  if (concurrent)
-    out.structure->parallel =
-        std::make_unique<detail::Built<detail::ParallelDelaunay>>();
-  else
     out.structure->sequential =
         std::make_unique<detail::Built<detail::SequentialDelaunay>>();
+  }
   // CGAL's insertion keeps scratch tables in thread-local storage that an exception
   // (std::bad_alloc) leaves dirty, which breaks every later insertion in the same
   // thread. Building in a thread of its own confines that state to this call.
@@ -363,13 +374,9 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
   if (failure)
     std::rethrow_exception(failure);
   std::vector<std::pair<Kernel::Point_3, int>>().swap(sites);
-  // The scratch the insertion freed lies in the builder's (and TBB's workers') malloc
-  // arenas, which glibc keeps mapped: hand it back before the passes add their
-  // arrays on top (measured peak on a million saddle points: 1005 -> 962 MB with two
-  // threads, 945 -> 928 MB with one).
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
+  // Before the passes add their arrays on top (measured peak on a million saddle
+  // points: 1005 -> 962 MB with two threads, 945 -> 928 MB with one).
+  trimMallocArenas();
   out.structure->visit(
       [&](const auto& built) { out.dimension = built.dt.dimension(); });
   if (out.dimension < 2) {
@@ -396,13 +403,9 @@ Triangulation::release()
   // asked before it has served anything.)
   if (concurrent)
     scalable_allocation_command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
-    // And glibc's: what the builder thread allocated lies in a malloc arena of its
-    // own, which worker threads reuse later; a small block left on top of a heap
-    // keeps glibc from unmapping the rest (measured: peak 1.41 GB instead of
-    // 0.96 GB on a million saddle points, two threads).
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
+  // And glibc's (measured: peak 1.41 GB instead of 0.96 GB on a million saddle
+  // points, two threads).
+  trimMallocArenas();
 }
 
 int
