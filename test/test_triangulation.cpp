@@ -7,10 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 
 using namespace pcl::cocone;
 
@@ -103,6 +105,47 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
     EXPECT_EQ(4 * cells, hull + 2 * own);
     EXPECT_GT(hull, 0u);
   }
+}
+
+TEST(Triangulate, EveryEdgeStoodForByACellOrOnTheHull)
+{
+  std::vector<Eigen::Vector3d> P;
+  std::mt19937 random(3);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 2000; ++i) { // a sphere: every point on the hull
+    const Eigen::Vector3d x(g(random), g(random), g(random));
+    P.push_back(x.normalized());
+  }
+  for (int i = 0; i < 2000; ++i)
+    P.emplace_back(g(random), g(random), g(random));
+  const Triangulation dt = triangulate(makeUniquePoints(P).points);
+  ASSERT_EQ(dt.dimension, 3);
+  const auto edge = [](int a, int b) {
+    return std::make_pair(std::min(a, b), std::max(a, b));
+  };
+  std::vector<std::pair<int, int>> all, stood_for;
+  std::size_t slots = 0;
+  forEachCell(dt, CellView::EDGES, 1, [&](const CellView& c, int) {
+    for (int e = 0; e < 6; ++e) {
+      const auto& ends = CellView::EDGE_ENDS[e];
+      all.push_back(edge(c.v[ends[0]], c.v[ends[1]]));
+      if (c.edges & (1u << e))
+        stood_for.push_back(all.back());
+    }
+    slots += 6;
+  });
+  const std::size_t offers = stood_for.size();
+  forEachHullFacet(dt, [&](const std::array<int, 4>& h) {
+    for (int k = 0; k < 3; ++k)
+      stood_for.push_back(edge(h[k], h[(k + 1) % 3]));
+  });
+  for (auto* edges : {&all, &stood_for}) {
+    std::sort(edges->begin(), edges->end());
+    edges->erase(std::unique(edges->begin(), edges->end()), edges->end());
+  }
+  EXPECT_EQ(stood_for, all);
+  // Far fewer than the six edges of every cell (about a third of them).
+  EXPECT_LT(offers, slots / 2) << offers << " of " << slots;
 }
 
 TEST(Triangulate, SameCellsWhateverTheThreads)

@@ -5,6 +5,8 @@
 
 #include <pcl/surface/cocone/triangulation.h>
 
+#include <boost/iterator/function_output_iterator.hpp>
+
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/spatial_sort.h>
 
@@ -419,35 +421,34 @@ resolveThreads(unsigned int requested)
   return requested == 0 ? available : static_cast<int>(requested);
 }
 
-std::vector<std::array<int, 4>>
-hullFacets(const Triangulation& triangulation)
+namespace detail {
+
+void
+visitHullFacets(const Triangulation& triangulation,
+                HullFacetVisitor visitor,
+                void* context)
 {
-  std::vector<std::array<int, 4>> out;
   if (!triangulation.structure || triangulation.dimension != 3)
-    return out;
+    return;
   triangulation.structure->visit([&](const auto& built) {
     const auto& dt = built.dt;
-    std::vector<typename std::remove_reference_t<decltype(dt)>::Cell_handle> outside;
-    dt.incident_cells(dt.infinite_vertex(), std::back_inserter(outside));
-    for (const auto c : outside) {
-      // The finite facet of an infinite cell, and the vertex across it.
-      const int i = c->index(dt.infinite_vertex());
-      const auto inside = c->neighbor(i);
-      const int j = inside->index(c);
-      std::array<int, 4> f;
-      for (int k = 0, m = 0; k < 4; ++k)
-        if (k != j)
-          f[m++] = inside->vertex(k)->info();
-      std::sort(f.begin(), f.begin() + 3);
-      f[3] = inside->vertex(j)->info();
-      out.push_back(f);
-    }
+    using Cell_handle = typename std::remove_reference_t<decltype(dt)>::Cell_handle;
+    // The finite facet of each infinite cell, and the vertex across it.
+    dt.incident_cells(dt.infinite_vertex(),
+                      boost::make_function_output_iterator([&](Cell_handle c) {
+                        const int i = c->index(dt.infinite_vertex());
+                        const auto inside = c->neighbor(i);
+                        const int j = inside->index(c);
+                        std::array<int, 4> f;
+                        for (int k = 0, m = 0; k < 4; ++k)
+                          if (k != j)
+                            f[m++] = inside->vertex(k)->info();
+                        std::sort(f.begin(), f.begin() + 3);
+                        f[3] = inside->vertex(j)->info();
+                        visitor(context, f);
+                      }));
   });
-  std::sort(out.begin(), out.end());
-  return out;
 }
-
-namespace detail {
 
 void
 visitCells(const Triangulation& triangulation,
@@ -502,6 +503,16 @@ visitCells(const Triangulation& triangulation,
         }
       if (data & CellView::CIRCUMCENTER)
         view.circumcenter = cached(cache, c);
+      view.edges = 0;
+      // The neighbours about edge (i, j) lie across the facets opposite its other two
+      // vertices; only their addresses are compared, the cells are not loaded.
+      for (int e = 0; (data & CellView::EDGES) && corners == 4 && e < 6; ++e) {
+        const auto& ends = CellView::EDGE_ENDS[e];
+        const int k = ends[0] == 0 ? (ends[1] == 1 ? 2 : 1) : 0;
+        const int l = 6 - ends[0] - ends[1] - k;
+        if (&*c < &*c->neighbor(k) && &*c < &*c->neighbor(l))
+          view.edges |= static_cast<std::uint8_t>(1u << e);
+      }
       for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
         if (i >= corners) {
           view.facet[i] = FacetRole::HULL;

@@ -275,75 +275,100 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
   vc.on_hull.assign(n, 0);
 
   // Pass 1 over the cells: the positive pole, the farthest Voronoi vertex (ties
-  // broken by position, so the choice does not depend on the visiting order). With
-  // several threads a vertex's record is updated under its own spin lock. The
-  // squared distance and the vertex are kept where h+ and the pole go.
+  // broken by position, so the choice does not depend on the visiting order), and
+  // the nearest neighbours, offered the edges each cell stands for (a third of the
+  // offers of all six edges of every cell, most of which repeat an edge kept
+  // already). With several threads a vertex's record is updated under its own spin
+  // lock. The squared distance and the vertex are kept where h+ and the pole go.
   std::vector<double>& far2 = vc.height_plus;
   std::vector<Eigen::Vector3d>& far = vc.pole;
   far2.assign(n, -1.0);
   far.assign(n, Eigen::Vector3d::Zero());
   std::vector<std::uint8_t> lock(threads > 1 ? n : 0, 0);
   NearestNeighbours nearest(P, vc.nearest);
-  forEachCell(dt, CellView::CIRCUMCENTER, threads, [&](const CellView& cell, int) {
-    for (const int a : cell.ahead)
-      if (a >= 0) {
-        nearest.prefetch(a);
-        __builtin_prefetch(&far2[a]);
-        __builtin_prefetch(&far[a]);
-        __builtin_prefetch(&P[a]);
-      }
-    const Eigen::Vector3d& cc = cell.circumcenter;
-    const bool finite = isFinite(cc);
-    // The six edges' lengths, each offered to both its ends.
-    std::array<std::array<float, 4>, 4> edge2;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j)
-        edge2[i][j] = edge2[j][i] = nearest.distance2(cell.v[i], cell.v[j]);
-    for (int i = 0; i < 4; ++i) {
-      const int v = cell.v[i];
-      const double d2 = (cc - P[v]).squaredNorm();
-      if (threads > 1)
-        while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
+  forEachCell(
+      dt,
+      CellView::CIRCUMCENTER | CellView::EDGES,
+      threads,
+      [&](const CellView& cell, int) {
+        for (const int a : cell.ahead)
+          if (a >= 0) {
+            nearest.prefetch(a);
+            __builtin_prefetch(&far2[a]);
+            __builtin_prefetch(&far[a]);
+            __builtin_prefetch(&P[a]);
+          }
+        const Eigen::Vector3d& cc = cell.circumcenter;
+        const bool finite = isFinite(cc);
+        // The lengths of the edges offered, each to both its ends.
+        std::array<std::array<float, 4>, 4> edge2;
+        for (int e = 0; e < 6; ++e)
+          if (cell.edges & (1u << e)) {
+            const int i = CellView::EDGE_ENDS[e][0], j = CellView::EDGE_ENDS[e][1];
+            edge2[i][j] = edge2[j][i] = nearest.distance2(cell.v[i], cell.v[j]);
+          }
+        for (int i = 0; i < 4; ++i) {
+          const int v = cell.v[i];
+          const double d2 = (cc - P[v]).squaredNorm();
+          if (threads > 1)
+            while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
+            }
+          for (int e = 0; e < 6; ++e) {
+            const auto& ends = CellView::EDGE_ENDS[e];
+            if ((cell.edges & (1u << e)) && (ends[0] == i || ends[1] == i)) {
+              const int j = ends[0] + ends[1] - i;
+              nearest.offer(v, cell.v[j], edge2[i][j]);
+            }
+          }
+          if (finite && (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc)))) {
+            far2[v] = d2;
+            far[v] = cc;
+          }
+          if (threads > 1)
+            __atomic_clear(&lock[v], __ATOMIC_RELEASE);
         }
-      for (int j = 0; j < 4; ++j)
-        if (j != i)
-          nearest.offer(v, cell.v[j], edge2[i][j]);
-      if (finite && (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc)))) {
-        far2[v] = d2;
-        far[v] = cc;
+      });
+  std::vector<std::uint8_t>().swap(lock);
+
+  // The convex hull, in one walk about the infinite vertex: its edges, which no cell
+  // need stand for, offered; per hull vertex the sum of the outward normals of its
+  // hull facets, the pole of its unbounded Voronoi cell. The sum is taken in fixed
+  // point: exact, so it does not depend on the walk's order (which follows the
+  // cells' addresses), and 2^-32 is far finer than a pole direction needs. (A
+  // sampled closed surface can have half its points on the hull.)
+  constexpr double FIXED = 4294967296.0;
+  std::vector<int> slot(n, -1);
+  std::vector<std::array<std::int64_t, 3>> sum;
+  forEachHullFacet(dt, [&](const std::array<int, 4>& h) {
+    const Eigen::Vector3d normal = outwardNormal(P, {h[0], h[1], h[2]}, h[3]);
+    std::array<std::int64_t, 3> fixed;
+    for (int m = 0; m < 3; ++m)
+      fixed[m] = std::llround(normal[m] * FIXED);
+    for (int k = 0; k < 3; ++k) {
+      const int a = h[k], b = h[(k + 1) % 3];
+      const float d2 = nearest.distance2(a, b);
+      nearest.offer(a, b, d2);
+      nearest.offer(b, a, d2);
+      if (slot[a] < 0) {
+        slot[a] = static_cast<int>(sum.size());
+        sum.push_back({0, 0, 0});
+        vc.on_hull[a] = 1;
       }
-      if (threads > 1)
-        __atomic_clear(&lock[v], __ATOMIC_RELEASE);
+      for (int m = 0; m < 3; ++m)
+        sum[slot[a]][m] += fixed[m];
     }
   });
-  std::vector<std::uint8_t>().swap(lock);
   nearest.release();
 
-  // The pole of a vertex on the convex hull: the sum of the outward normals of its
-  // hull facets, added in facet order so that the sum is reproducible. (A sampled
-  // closed surface can have half its points on the hull: no per-facet records.)
-  const std::vector<std::array<int, 4>> hull = hullFacets(dt);
-  const auto hullNormal = [&](const std::array<int, 4>& h) {
-    return outwardNormal(P, {h[0], h[1], h[2]}, h[3]);
-  };
-  std::vector<int> slot(n, -1);
-  int hull_vertices = 0;
-  for (const auto& h : hull)
-    for (int k = 0; k < 3; ++k)
-      if (slot[h[k]] < 0) {
-        slot[h[k]] = hull_vertices++;
-        vc.on_hull[h[k]] = 1;
-      }
-  std::vector<Eigen::Vector3d> sum(hull_vertices, Eigen::Vector3d::Zero());
-  for (const auto& h : hull) {
-    const Eigen::Vector3d normal = hullNormal(h);
-    for (int k = 0; k < 3; ++k)
-      sum[slot[h[k]]] += normal;
-  }
   for (std::size_t v = 0; v < n; ++v) {
-    if (vc.on_hull[v] && sum[slot[v]].norm() > 0.0) {
+    const Eigen::Vector3d normal =
+        vc.on_hull[v] ? Eigen::Vector3d(static_cast<double>(sum[slot[v]][0]),
+                                        static_cast<double>(sum[slot[v]][1]),
+                                        static_cast<double>(sum[slot[v]][2]))
+                      : Eigen::Vector3d::Zero();
+    if (normal != Eigen::Vector3d::Zero()) {
       far2[v] = INF;
-      far[v] = sum[slot[v]].normalized();
+      far[v] = normal.normalized();
     }
     else if (far2[v] > 0.0) {
       far2[v] = std::sqrt(far2[v]);

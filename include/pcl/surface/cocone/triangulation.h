@@ -110,7 +110,15 @@ struct CellView {
    * its per-vertex records into the cache before it needs them. */
   std::array<int, 4> ahead;
   /** What a pass asks forEachCell() to compute, besides the vertices and facets. */
-  enum Data : unsigned int { CIRCUMCENTER = 1, FACETS = 2, NEIGHBORS = 4 | FACETS };
+  enum Data : unsigned int {
+    CIRCUMCENTER = 1,
+    FACETS = 2,
+    NEIGHBORS = 4 | FACETS,
+    EDGES = 8
+  };
+  /** The six edges of a tetrahedron, as pairs of indices into v. */
+  static constexpr std::array<std::array<int, 2>, 6> EDGE_ENDS{
+      {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
   /** The circumcenter (the cell's Voronoi vertex), if CIRCUMCENTER was asked. */
   Eigen::Vector3d circumcenter;
   /** The facet opposite v[i] (the edge, in dimension 2), if FACETS was asked. */
@@ -118,14 +126,16 @@ struct CellView {
   /** For an OWN facet, the circumcenter of the cell across it, if NEIGHBORS was
    * asked. */
   std::array<Eigen::Vector3d, 4> neighbor_circumcenter;
+  /** Bit e set: this cell stands for edge EDGE_ENDS[e], if EDGES was asked
+   * (dimension 3). Of the cells around an edge, those whose two neighbours about it
+   * lie at higher addresses stand for it: at least one (the lowest) unless the ring
+   * contains an infinite cell, i.e. unless the edge lies on the convex hull; about
+   * a third of them in general. A pass that needs every Delaunay edge once or more
+   * reads these and the edges of the hull facets (forEachHullFacet()). */
+  std::uint8_t edges;
   /** Number of vertices: 4, or 3 in dimension 2. */
   int corners;
 };
-
-/** \brief The facets on the convex hull (dimension 3): three vertex ids ascending,
- * then the id of the vertex across the facet inside the hull; sorted. */
-std::vector<std::array<int, 4>>
-hullFacets(const Triangulation& dt);
 
 namespace detail {
 using CellVisitor = void (*)(void* context, const CellView& cell, int thread);
@@ -135,7 +145,25 @@ visitCells(const Triangulation& dt,
            int threads,
            CellVisitor visitor,
            void* context);
+using HullFacetVisitor = void (*)(void* context, const std::array<int, 4>& facet);
+void
+visitHullFacets(const Triangulation& dt, HullFacetVisitor visitor, void* context);
 } // namespace detail
+
+/** \brief Call visit(facet) once for every facet on the convex hull (dimension 3):
+ * its three vertex ids ascending, then the id of the vertex across it inside the
+ * hull. The order of the calls is unspecified. */
+template <typename Visit>
+void
+forEachHullFacet(const Triangulation& dt, Visit&& visit)
+{
+  detail::visitHullFacets(
+      dt,
+      [](void* context, const std::array<int, 4>& facet) {
+        (*static_cast<std::remove_reference_t<Visit>*>(context))(facet);
+      },
+      const_cast<void*>(static_cast<const void*>(&visit)));
+}
 
 /** \brief Call visit(cell, thread) once for every finite cell.
  *
