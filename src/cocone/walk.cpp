@@ -44,9 +44,9 @@ surfaceNeighbor(const TriangleComplex& complex,
     const double cx = w.dot(u);
     if (cx >= 0.0)
       continue;
-    double phi = std::atan2(w.dot(n), cx);
-    if (phi < 0.0)
-      phi += 2.0 * M_PI;
+    // The angle from u about the edge lies in (pi/2, 3pi/2), where its tangent
+    // w.n / cx grows with it: the smallest tangent is the smallest angle.
+    const double phi = w.dot(n) / cx;
     if (best < 0 || phi < best_phi) {
       best = t2;
       best_phi = phi;
