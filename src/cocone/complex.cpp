@@ -39,24 +39,17 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Edges: the incidences grouped by edge once. Incidence (t, k) runs from corner k
   // to corner k + 1, so it is the edge opposite corner k + 2.
-  std::vector<std::uint32_t> start;
   const std::vector<std::uint64_t> word =
-      detail::groupEdgeIncidences(triangles_, start);
+      detail::groupEdgeIncidences(triangles_, edges_, edge_first_);
   triangle_edges_.resize(m);
   edge_triangles_.resize(word.size());
-  for (std::size_t v = 0; v + 1 < start.size(); ++v)
-    for (std::size_t i = start[v]; i < start[v + 1]; ++i) {
-      const int other = static_cast<int>(word[i] >> 32);
-      if (i == start[v] || other != static_cast<int>(word[i - 1] >> 32)) {
-        edge_first_.push_back(i);
-        edges_.push_back({static_cast<int>(v), other});
-      }
-      const int t = static_cast<int>((word[i] & 0xffffffffu) >> 2);
-      triangle_edges_[t][((word[i] & 3u) + 2) % 3] =
-          static_cast<int>(edges_.size()) - 1;
+  for (std::size_t e = 0; e < edges_.size(); ++e)
+    for (std::size_t i = edge_first_[e]; i < edge_first_[e + 1]; ++i) {
+      const int t = detail::incidenceTriangle(word[i]);
+      triangle_edges_[t][(detail::incidenceCorner(word[i]) + 2) % 3] =
+          static_cast<int>(e);
       edge_triangles_[i] = t;
     }
-  edge_first_.push_back(word.size());
 
   // Angles about each edge in a frame of the edge.
   edge_angles_.resize(word.size());

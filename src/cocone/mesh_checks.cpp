@@ -52,27 +52,16 @@ struct DisjointSets {
 
 EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
 {
-  std::vector<std::uint32_t> start;
-  const std::vector<std::uint64_t> word = detail::groupEdgeIncidences(oriented, start);
-  std::size_t count = 0;
-  for (std::size_t v = 0; v + 1 < start.size(); ++v)
-    for (std::size_t i = start[v]; i < start[v + 1]; ++i)
-      count += i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
-  edges.reserve(count);
-  first.reserve(count + 1);
+  const std::vector<std::uint64_t> word =
+      detail::groupEdgeIncidences(oriented, edges, first);
   triangle.resize(word.size());
   forward.resize(word.size());
-  for (std::size_t v = 0; v + 1 < start.size(); ++v)
-    for (std::size_t i = start[v]; i < start[v + 1]; ++i) {
-      const int other = static_cast<int>(word[i] >> 32);
-      if (i == start[v] || other != static_cast<int>(word[i - 1] >> 32)) {
-        first.push_back(i);
-        edges.push_back({static_cast<int>(v), other});
-      }
-      triangle[i] = static_cast<int>((word[i] & 0xffffffffu) >> 2);
-      forward[i] = static_cast<int>(v) == oriented[triangle[i]][word[i] & 3u];
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    for (std::size_t i = first[e]; i < first[e + 1]; ++i) {
+      triangle[i] = detail::incidenceTriangle(word[i]);
+      forward[i] =
+          edges[e][0] == oriented[triangle[i]][detail::incidenceCorner(word[i])];
     }
-  first.push_back(word.size());
 }
 
 std::vector<int>

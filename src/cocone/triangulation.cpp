@@ -504,13 +504,11 @@ visitCells(const Triangulation& triangulation,
       if (data & CellView::CIRCUMCENTER)
         view.circumcenter = cached(cache, c);
       view.edges = 0;
-      // The neighbours about edge (i, j) lie across the facets opposite its other two
+      // The neighbours about an edge lie across the facets opposite the other two
       // vertices; only their addresses are compared, the cells are not loaded.
       for (int e = 0; (data & CellView::EDGES) && corners == 4 && e < 6; ++e) {
-        const auto& ends = CellView::EDGE_ENDS[e];
-        const int k = ends[0] == 0 ? (ends[1] == 1 ? 2 : 1) : 0;
-        const int l = 6 - ends[0] - ends[1] - k;
-        if (&*c < &*c->neighbor(k) && &*c < &*c->neighbor(l))
+        const auto& across = CellView::EDGE_ENDS[5 - e];
+        if (&*c < &*c->neighbor(across[0]) && &*c < &*c->neighbor(across[1]))
           view.edges |= static_cast<std::uint8_t>(1u << e);
       }
       for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {

@@ -47,7 +47,7 @@ outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f
 /** Gathers VoronoiCells::nearest: per vertex the nearest Delaunay neighbours offered
  * so far, ties by id, with their squared distances in float beside them (the order
  * only has to be reproducible). Most offers are of a neighbour too far or already
- * kept (about ten cells share an edge): both are rejected without a search. */
+ * kept (several cells stand for an edge): both are rejected without a search. */
 class NearestNeighbours {
 public:
   static constexpr int K = VoronoiCells::NEAREST;

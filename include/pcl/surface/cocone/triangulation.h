@@ -116,7 +116,8 @@ struct CellView {
     NEIGHBORS = 4 | FACETS,
     EDGES = 8
   };
-  /** The six edges of a tetrahedron, as pairs of indices into v. */
+  /** The six edges of a tetrahedron, as pairs of indices into v; edge 5 - e joins
+   * the two vertices not on edge e. */
   static constexpr std::array<std::array<int, 2>, 6> EDGE_ENDS{
       {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
   /** The circumcenter (the cell's Voronoi vertex), if CIRCUMCENTER was asked. */
