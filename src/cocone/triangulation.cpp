@@ -54,35 +54,24 @@ toEigen(const CGAL::Exact_predicates_exact_constructions_kernel::Point_3& p)
 UniquePoints
 makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
 {
-  std::vector<int> order;
-  order.reserve(input.size());
+  UniquePoints out;
+  out.vertex_of_input.assign(input.size(), -1);
+  std::vector<int> finite;
+  finite.reserve(input.size());
   for (std::size_t i = 0; i < input.size(); ++i)
     if (isFinite(input[i]))
-      order.push_back(static_cast<int>(i));
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return lexLess(input[a], input[b]) || (input[a] == input[b] && a < b);
-  });
-
-  std::vector<Eigen::Vector3d> sorted;
-  std::vector<int> sorted_of_input(input.size(), -1);
-  for (const int i : order) {
-    if (sorted.empty() || sorted.back() != input[i])
-      sorted.push_back(input[i]);
-    sorted_of_input[i] = static_cast<int>(sorted.size()) - 1;
-  }
+      finite.push_back(static_cast<int>(i));
+  if (finite.empty())
+    return out;
 
   // Number the vertices along a Morton (Z-order) curve, ties in lexicographic order:
   // neighbours in space get nearby ids, which keeps the per-cell passes cache
-  // friendly, and the numbering still depends only on the point set.
-  UniquePoints out;
-  if (sorted.empty()) {
-    out.vertex_of_input.assign(input.size(), -1);
-    return out;
-  }
-  Eigen::Vector3d lo = sorted.front(), hi = sorted.front();
-  for (const auto& p : sorted) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
+  // friendly, and the numbering still depends only on the point set. Duplicates
+  // share a code and sort next to each other: one sort does both.
+  Eigen::Vector3d lo = input[finite.front()], hi = lo;
+  for (const int i : finite) {
+    lo = lo.cwiseMin(input[i]);
+    hi = hi.cwiseMax(input[i]);
   }
   const double extent =
       std::max((hi - lo).maxCoeff(), std::numeric_limits<double>::min());
@@ -95,26 +84,29 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     v = (v | v << 2) & 0x1249249249249249ULL;
     return v;
   };
-  std::vector<std::pair<std::uint64_t, int>> keys(sorted.size());
-  for (std::size_t i = 0; i < sorted.size(); ++i) {
+  std::vector<std::pair<std::uint64_t, int>> keys;
+  keys.reserve(finite.size());
+  for (const int i : finite) {
     std::uint64_t code = 0;
     for (int k = 0; k < 3; ++k) {
-      const double t = (sorted[i][k] - lo[k]) / extent * 2097151.0;
+      const double t = (input[i][k] - lo[k]) / extent * 2097151.0;
       code |= spread(static_cast<std::uint64_t>(std::clamp(t, 0.0, 2097151.0))) << k;
     }
-    keys[i] = {code, static_cast<int>(i)};
+    keys.emplace_back(code, i);
   }
-  std::sort(keys.begin(), keys.end());
-  std::vector<int> vertex_of_sorted(sorted.size());
-  out.points.resize(sorted.size());
-  for (std::size_t v = 0; v < keys.size(); ++v) {
-    vertex_of_sorted[keys[v].second] = static_cast<int>(v);
-    out.points[v] = sorted[keys[v].second];
+  std::vector<int>().swap(finite);
+  std::sort(keys.begin(), keys.end(), [&](const auto& a, const auto& b) {
+    if (a.first != b.first)
+      return a.first < b.first;
+    return lexLess(input[a.second], input[b.second]) ||
+           (input[a.second] == input[b.second] && a.second < b.second);
+  });
+  for (const auto& key : keys) {
+    const Eigen::Vector3d& p = input[key.second];
+    if (out.points.empty() || out.points.back() != p)
+      out.points.push_back(p);
+    out.vertex_of_input[key.second] = static_cast<int>(out.points.size()) - 1;
   }
-  out.vertex_of_input.resize(input.size());
-  for (std::size_t i = 0; i < input.size(); ++i)
-    out.vertex_of_input[i] =
-        sorted_of_input[i] < 0 ? -1 : vertex_of_sorted[sorted_of_input[i]];
   return out;
 }
 
