@@ -351,6 +351,55 @@ TEST(Repair, FilledHolesLeaveAnOrientedManifold)
   EXPECT_EQ(counts.flipped, 0u);
 }
 
+TEST(Repair, IncidencesHandedOnMatchTheTriangles)
+{
+  const auto s = cocone_test::monkeySaddle(options(5000, 0.05));
+  const Result r =
+      pcl::cocone::run(s.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_GT(r.triangles.size(), 5000u);
+  using pcl::cocone::EdgeIncidences;
+  const auto expect_grouped = [](const EdgeIncidences& inc,
+                                 const std::vector<pcl::cocone::Triangle>& mesh) {
+    const EdgeIncidences fresh(mesh);
+    EXPECT_EQ(inc.edges, fresh.edges);
+    EXPECT_EQ(inc.first, fresh.first);
+    EXPECT_EQ(inc.triangle, fresh.triangle);
+    EXPECT_EQ(inc.forward, fresh.forward);
+  };
+  // Every seventh triangle dropped, every fifth of the others turned over: the
+  // repair turns them back.
+  std::vector<pcl::cocone::Triangle> mesh, allowed;
+  for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+    auto v = r.triangles[t];
+    std::sort(v.begin(), v.end());
+    allowed.push_back(v);
+    if (t % 7 != 3) {
+      v = r.triangles[t];
+      if (t % 5 == 0)
+        std::swap(v[1], v[2]);
+      mesh.push_back(v);
+    }
+  }
+  std::sort(allowed.begin(), allowed.end());
+  pcl::cocone::RepairCounts counts;
+  EdgeIncidences inc;
+  pcl::cocone::repairManifold(r.positions, mesh, counts, 1, &inc);
+  EXPECT_GT(counts.flipped, 0u);
+  expect_grouped(inc, mesh);
+  // The ribbons' step takes them on and hands on those of what it leaves.
+  auto unfilled = mesh;
+  EdgeIncidences kept = inc;
+  pcl::cocone::dropRibbons(unfilled, r.positions.size(), &kept);
+  expect_grouped(kept, unfilled);
+  // Filling the holes makes them stale: emptied, and grouped again after.
+  ASSERT_GT(pcl::cocone::fillHoles(r.positions, mesh, allowed, 3, &inc), 0u);
+  EXPECT_TRUE(inc.first.empty());
+  pcl::cocone::dropRibbons(mesh, r.positions.size(), &inc);
+  expect_grouped(inc, mesh);
+  EXPECT_EQ(pcl::cocone::boundaryLoops(inc, r.positions.size()),
+            pcl::cocone::boundaryLoops(mesh, r.positions.size()));
+}
+
 TEST(Reconstruction, Deterministic)
 {
   const auto s = cocone_test::monkeySaddle(options(5000, 0.05));

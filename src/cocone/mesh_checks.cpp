@@ -189,7 +189,12 @@ analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices)
 std::vector<std::vector<int>>
 boundaryLoops(const std::vector<Triangle>& oriented, std::size_t num_vertices)
 {
-  const EdgeIncidences inc(oriented);
+  return boundaryLoops(EdgeIncidences(oriented), num_vertices);
+}
+
+std::vector<std::vector<int>>
+boundaryLoops(const EdgeIncidences& inc, std::size_t num_vertices)
+{
   // The border half-edges a -> b as the triangles traverse them.
   std::vector<int> next(num_vertices, -1);
   std::vector<int> starts;

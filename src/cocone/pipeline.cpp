@@ -81,7 +81,10 @@ reconstruct(Triangulation& dt,
   counts.walk_reseeds = walked.reseeds;
 
   result.triangles = std::move(walked.triangles);
-  repairManifold(dt.points, result.triangles, counts.repair, threads);
+  // Grouped by the repair, the edge incidences serve the steps after it until one
+  // changes the triangles.
+  EdgeIncidences incidences;
+  repairManifold(dt.points, result.triangles, counts.repair, threads, &incidences);
   if (parameters.fill_hole_edges >= 3) {
     std::vector<Triangle> delaunay;
     delaunay.reserve(cells.triangles.size());
@@ -92,10 +95,13 @@ reconstruct(Triangulation& dt,
     // against the loop, so the mesh stays an oriented manifold (checked on the
     // tests, the synthetic table and the range scans: a repair after filling never
     // changed a triangle).
-    counts.repair.filled =
-        fillHoles(dt.points, result.triangles, delaunay, parameters.fill_hole_edges);
+    counts.repair.filled = fillHoles(
+        dt.points, result.triangles, delaunay, parameters.fill_hole_edges, &incidences);
   }
-  counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size());
+  counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size(), &incidences);
+  // The borders, in vertex ids (neither the order of the triangles nor the corner
+  // each starts at, both set below, matters to them).
+  result.border_loops = boundaryLoops(incidences, dt.points.size());
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
@@ -230,11 +236,9 @@ runStages(std::vector<Eigen::Vector3d>&& points,
     result.polygons.push_back({result.representative[t[0]],
                                result.representative[t[1]],
                                result.representative[t[2]]});
-  for (auto& loop : boundaryLoops(result.triangles, result.vertices)) {
+  for (auto& loop : result.border_loops)
     for (auto& v : loop)
       v = result.representative[v];
-    result.border_loops.push_back(std::move(loop));
-  }
   result.positions = dt.points;
   return result;
 }

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <optional>
 #include <queue>
 #include <tuple>
 
@@ -136,11 +135,17 @@ std::size_t
 orient(const std::vector<Eigen::Vector3d>& P,
        std::vector<Triangle>& triangles,
        const EdgeIncidences& inc,
-       std::size_t& flipped)
+       std::size_t& flipped,
+       std::vector<std::uint8_t>& turned_over)
 {
   // inc's edges and triangles stay valid while triangles are turned over; the
   // direction of traversal is read from the triangles themselves.
   const std::size_t m = triangles.size();
+  turned_over.assign(m, 0); // each turn toggles it
+  const auto turn = [&](int t) {
+    std::swap(triangles[t][1], triangles[t][2]);
+    turned_over[t] ^= 1;
+  };
   // Per triangle: its edges' ids, found through the incidences.
   std::vector<std::array<int, 3>> tri_edges(m);
   std::vector<int> filled(m, 0);
@@ -214,7 +219,7 @@ orient(const std::vector<Eigen::Vector3d>& P,
         component[t2] = c;
         members.push_back(t2);
         if (disagree(t, t2, e)) {
-          std::swap(triangles[t2][1], triangles[t2][2]);
+          turn(t2);
           turned[t2] = 1;
         }
       }
@@ -227,7 +232,7 @@ orient(const std::vector<Eigen::Vector3d>& P,
       normal.resize(m);
       for (const int t : members) {
         if (turned[t])
-          std::swap(triangles[t][1], triangles[t][2]);
+          turn(t);
         component[t] = -1;
         normal[t] = unitNormal(P, triangles[t]);
       }
@@ -251,7 +256,7 @@ orient(const std::vector<Eigen::Vector3d>& P,
           if (f == g)
             e = f;
       if (traverses_forward(t, e) == traverses_forward(t2, e)) {
-        std::swap(triangles[t2][1], triangles[t2][2]);
+        turn(t2);
         normal[t2] = -normal[t2];
         ++flipped;
       }
@@ -281,7 +286,7 @@ orient(const std::vector<Eigen::Vector3d>& P,
     }
     if (volume < 0.0)
       for (const int t : members)
-        std::swap(triangles[t][1], triangles[t][2]);
+        turn(t);
     ++c;
   }
   return compact(triangles, drop);
@@ -293,10 +298,11 @@ void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
                RepairCounts& counts,
-               int threads)
+               int threads,
+               EdgeIncidences* incidences)
 {
   for (;;) {
-    const EdgeIncidences inc(triangles);
+    EdgeIncidences inc(triangles);
     if (const std::size_t d = resolveEdges(points, triangles, inc)) {
       counts.nonmanifold_edge += d;
       continue;
@@ -313,12 +319,18 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
       touched.swap(again);
     }
     counts.nonmanifold_vertex += dropped;
-    std::optional<EdgeIncidences> rebuilt;
     if (dropped)
-      rebuilt.emplace(triangles);
-    d = orient(points, triangles, rebuilt ? *rebuilt : inc, counts.flipped);
-    if (d == 0)
+      inc = EdgeIncidences(triangles);
+    std::vector<std::uint8_t> turned_over;
+    d = orient(points, triangles, inc, counts.flipped, turned_over);
+    if (d == 0) {
+      if (incidences) { // the same edges; the turned triangles run the other way
+        for (std::size_t i = 0; i < inc.triangle.size(); ++i)
+          inc.forward[i] ^= turned_over[inc.triangle[i]];
+        *incidences = std::move(inc);
+      }
       return;
+    }
     counts.orientation += d;
   }
 }
@@ -327,10 +339,14 @@ std::size_t
 fillHoles(const std::vector<Eigen::Vector3d>& points,
           std::vector<Triangle>& triangles,
           const std::vector<Triangle>& allowed,
-          std::size_t max_edges)
+          std::size_t max_edges,
+          EdgeIncidences* incidences)
 {
   const std::size_t num_vertices = points.size();
-  const EdgeIncidences inc(triangles);
+  EdgeIncidences grouped;
+  if (!incidences || incidences->first.empty())
+    grouped = EdgeIncidences(triangles);
+  const EdgeIncidences& inc = grouped.first.empty() ? *incidences : grouped;
   // Hole half-edges run against the border half-edges of the triangles.
   std::vector<int> hole_next(num_vertices, -1);
   std::vector<int> starts;
@@ -431,14 +447,22 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       stack.push_back({m, j});
     }
   }
+  if (added && incidences)
+    *incidences = EdgeIncidences(); // stale: not known any more
   return added;
 }
 
 std::size_t
-dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices)
+dropRibbons(std::vector<Triangle>& triangles,
+            std::size_t num_vertices,
+            EdgeIncidences* incidences)
 {
   std::size_t count = 0;
-  const EdgeIncidences inc(triangles);
+  EdgeIncidences inc;
+  if (incidences && !incidences->first.empty())
+    inc = std::move(*incidences);
+  else
+    inc = EdgeIncidences(triangles);
   const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
   std::vector<std::uint8_t> on_border(num_vertices, 0);
   for (std::size_t e = 0; e < inc.edges.size(); ++e)
@@ -452,7 +476,10 @@ dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices)
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   for (std::size_t t = 0; t < triangles.size(); ++t)
     drop[t] = !inner[component[t]];
-  return compact(triangles, drop);
+  const std::size_t dropped = compact(triangles, drop);
+  if (incidences)
+    *incidences = dropped ? EdgeIncidences(triangles) : std::move(inc);
+  return dropped;
 }
 
 } // namespace cocone

@@ -24,6 +24,10 @@ struct EdgeIncidences {
   std::vector<int> triangle;             ///< per incidence
   std::vector<std::uint8_t> forward;     ///< per incidence: traverses lower -> higher
 
+  /** None: not grouped yet (first is empty; a grouping of no triangle has one
+   * offset). */
+  EdgeIncidences() = default;
+
   /** Group the edges of \a oriented. */
   explicit EdgeIncidences(const std::vector<Triangle>& oriented);
 
@@ -79,6 +83,10 @@ analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices);
  * sorted by that vertex. */
 std::vector<std::vector<int>>
 boundaryLoops(const std::vector<Triangle>& oriented, std::size_t num_vertices);
+
+/** \brief boundaryLoops() from the mesh's edge incidences. */
+std::vector<std::vector<int>>
+boundaryLoops(const EdgeIncidences& inc, std::size_t num_vertices);
 
 /** \brief The vertices of the edges that lie in exactly one triangle (the border
  * vertices of any triangle mesh, manifold or not), ascending. */

@@ -14,6 +14,8 @@
 namespace pcl {
 namespace cocone {
 
+struct EdgeIncidences;
+
 /** \brief What the repair after the walk changed, in triangles. */
 struct RepairCounts {
   /** Dropped at edges with more than two triangles. */
@@ -53,12 +55,15 @@ struct RepairCounts {
  * \param[in,out] triangles oriented triangles
  * \param[in,out] counts what was changed (added to)
  * \param[in] threads threads for the vertex fans
+ * \param[out] incidences if given, the edge incidences of the repaired triangles,
+ *             for fillHoles() to go on with
  */
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
                RepairCounts& counts,
-               int threads = 1);
+               int threads = 1,
+               EdgeIncidences* incidences = nullptr);
 
 /** \brief Close border loops of at most \a max_edges edges by triangles from
  * \a allowed (sorted vertex triples, ascending), oriented with their neighbours.
@@ -69,21 +74,29 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
  * one stays open. The mesh must be an oriented 2-manifold, as repairManifold()
  * leaves it; it stays one (each hole is a simple loop, as every vertex has one fan,
  * and its triangles run against the loop), so no repair is needed afterwards.
+ * \param[in,out] incidences if given and not empty, the edge incidences of
+ *                \a triangles (grouped here otherwise); emptied if triangles are added
  * \return the number of triangles added
  */
 std::size_t
 fillHoles(const std::vector<Eigen::Vector3d>& points,
           std::vector<Triangle>& triangles,
           const std::vector<Triangle>& allowed,
-          std::size_t max_edges = 3);
+          std::size_t max_edges = 3,
+          EdgeIncidences* incidences = nullptr);
 
 /** \brief Drop every component of the mesh that has no inner vertex (every vertex on
  * its border): a strip one triangle wide, such as a walk leaves from a border band,
  * samples no piece of surface.
+ * \param[in,out] incidences if given and not empty, the edge incidences of
+ *                \a triangles (grouped here otherwise); on return those of the
+ *                triangles left
  * \return the number of triangles dropped
  */
 std::size_t
-dropRibbons(std::vector<Triangle>& triangles, std::size_t num_vertices);
+dropRibbons(std::vector<Triangle>& triangles,
+            std::size_t num_vertices,
+            EdgeIncidences* incidences = nullptr);
 
 } // namespace cocone
 } // namespace pcl
