@@ -138,27 +138,34 @@ orient(const std::vector<Eigen::Vector3d>& P,
        std::size_t& flipped,
        std::vector<std::uint8_t>& turned_over)
 {
-  // inc's edges and triangles stay valid while triangles are turned over; the
-  // direction of traversal is read from the triangles themselves.
+  // inc's edges and triangles stay valid while triangles are turned over: whether
+  // two neighbours run their edge the same way (and so disagree) is read from the
+  // incidences once, and follows from the turns since.
   const std::size_t m = triangles.size();
   turned_over.assign(m, 0); // each turn toggles it
   const auto turn = [&](int t) {
     std::swap(triangles[t][1], triangles[t][2]);
     turned_over[t] ^= 1;
   };
-  // Per triangle: its edges' ids, found through the incidences.
-  std::vector<std::array<int, 3>> tri_edges(m);
-  std::vector<int> filled(m, 0);
-  for (std::size_t e = 0; e < inc.edges.size(); ++e)
-    for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i)
-      tri_edges[inc.triangle[i]][filled[inc.triangle[i]]++] = static_cast<int>(e);
-  const auto traverses_forward = [&](int t, int e) {
-    const auto& v = triangles[t];
-    const int a = inc.edges[e][0], b = inc.edges[e][1];
-    for (int k = 0; k < 3; ++k)
-      if (v[k] == a && v[(k + 1) % 3] == b)
-        return true;
-    return false;
+  // Per triangle, in the order of its edges: the neighbour across each (-1 at a
+  // border edge), and bit k set if neighbour k ran the edge the same way at first.
+  std::vector<std::array<int, 3>> across(m, {-1, -1, -1});
+  std::vector<std::uint8_t> alike(m, 0);
+  {
+    std::vector<std::uint8_t> filled(m, 0);
+    for (std::size_t e = 0; e < inc.edges.size(); ++e)
+      for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i) {
+        const int t = inc.triangle[i], k = filled[t]++;
+        if (inc.count(e) != 2)
+          continue;
+        const std::size_t j = i == inc.first[e] ? i + 1 : i - 1;
+        across[t][k] = inc.triangle[j];
+        if (inc.forward[i] == inc.forward[j])
+          alike[t] |= static_cast<std::uint8_t>(1u << k);
+      }
+  }
+  const auto disagree = [&](int t, int k) {
+    return (((alike[t] >> k) & 1u) ^ turned_over[t] ^ turned_over[across[t][k]]) != 0;
   };
 
   // Each component grows from its lowest triangle, across the edge whose two
@@ -175,29 +182,18 @@ orient(const std::vector<Eigen::Vector3d>& P,
   std::priority_queue<Entry> heap;
   int c = 0, rank = 0;
   const auto offer = [&](int t) {
-    for (const int e : tri_edges[t]) {
-      if (inc.count(e) != 2)
+    for (int k = 0; k < 3; ++k) {
+      const int t2 = across[t][k];
+      if (t2 < 0 || component[t2] >= 0)
         continue;
-      const std::size_t i = inc.first[e];
-      const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
-      if (component[t2] >= 0)
-        continue;
-      const bool same = traverses_forward(t, e) == traverses_forward(t2, e);
       const double agree =
-          normal[t].dot(same ? Eigen::Vector3d(-normal[t2]) : normal[t2]);
+          normal[t].dot(disagree(t, k) ? Eigen::Vector3d(-normal[t2]) : normal[t2]);
       heap.emplace(agree, -t2, -t);
     }
   };
   // A component that can be oriented has one orientation given its seed's: a
   // breadth-first pass finds it, and only where it meets a disagreement does the
   // order matter and the pass run again in Prim's order.
-  const auto across = [&](int t, int e) {
-    const std::size_t i = inc.first[e];
-    return inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
-  };
-  const auto disagree = [&](int t, int t2, int e) {
-    return traverses_forward(t, e) == traverses_forward(t2, e);
-  };
   std::vector<std::uint8_t> turned(m, 0);
   for (std::size_t s = 0; s < m; ++s, members.clear()) {
     if (component[s] >= 0)
@@ -207,18 +203,18 @@ orient(const std::vector<Eigen::Vector3d>& P,
     bool consistent = true;
     for (std::size_t q = 0; q < members.size(); ++q) {
       const int t = members[q];
-      for (const int e : tri_edges[t]) {
-        if (inc.count(e) != 2)
+      for (int k = 0; k < 3; ++k) {
+        const int t2 = across[t][k];
+        if (t2 < 0)
           continue;
-        const int t2 = across(t, e);
         if (component[t2] >= 0) {
           // Both oriented: each edge inside the component is met so at least once.
-          consistent = consistent && !disagree(t, t2, e);
+          consistent = consistent && !disagree(t, k);
           continue;
         }
         component[t2] = c;
         members.push_back(t2);
-        if (disagree(t, t2, e)) {
+        if (disagree(t, k)) {
           turn(t2);
           turned[t2] = 1;
         }
@@ -250,12 +246,10 @@ orient(const std::vector<Eigen::Vector3d>& P,
       component[t2] = c;
       order[t2] = rank++;
       members.push_back(t2);
-      int e = -1;
-      for (const int f : tri_edges[t2])
-        for (const int g : tri_edges[t])
-          if (f == g)
-            e = f;
-      if (traverses_forward(t, e) == traverses_forward(t2, e)) {
+      int k = 0; // the side of t2 towards t
+      while (across[t2][k] != t)
+        ++k;
+      if (disagree(t2, k)) {
         turn(t2);
         normal[t2] = -normal[t2];
         ++flipped;
@@ -265,13 +259,9 @@ orient(const std::vector<Eigen::Vector3d>& P,
     // A non-orientable cycle closes at an edge whose triangles still disagree: drop
     // the one reached later (through the worse edge).
     for (const int t : members)
-      for (const int e : tri_edges[t]) {
-        if (inc.count(e) != 2)
-          continue;
-        const std::size_t i = inc.first[e];
-        const int t2 = inc.triangle[i] == t ? inc.triangle[i + 1] : inc.triangle[i];
-        if (t2 < t && traverses_forward(t, e) == traverses_forward(t2, e) && !drop[t] &&
-            !drop[t2])
+      for (int k = 0; k < 3; ++k) {
+        const int t2 = across[t][k];
+        if (t2 >= 0 && t2 < t && disagree(t, k) && !drop[t] && !drop[t2])
           drop[order[t] > order[t2] ? t : t2] = 1;
       }
     // Turn the component so that its signed volume about its centroid is positive.
