@@ -400,6 +400,38 @@ TEST(Repair, IncidencesHandedOnMatchTheTriangles)
             pcl::cocone::boundaryLoops(mesh, r.positions.size()));
 }
 
+TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)
+{
+  // A band of 2n triangles with a half twist: no orientation agrees all round, so
+  // the orientation step grows it in Prim's order and drops a triangle at the seam.
+  const int n = 40;
+  std::vector<Eigen::Vector3d> P;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * M_PI * i / n;
+    const Eigen::Vector3d centre(std::cos(t), std::sin(t), 0.0);
+    const Eigen::Vector3d across =
+        std::cos(t / 2.0) * centre + std::sin(t / 2.0) * Eigen::Vector3d::UnitZ();
+    P.push_back(centre + 0.3 * across);
+    P.push_back(centre - 0.3 * across);
+  }
+  std::vector<pcl::cocone::Triangle> mesh;
+  for (int i = 0; i < n; ++i) {
+    int a = 2 * ((i + 1) % n), b = a + 1;
+    if (i == n - 1)
+      std::swap(a, b); // the twist
+    mesh.push_back({2 * i, 2 * i + 1, a});
+    mesh.push_back({2 * i + 1, b, a});
+  }
+  pcl::cocone::RepairCounts counts;
+  pcl::cocone::repairManifold(P, mesh, counts);
+  EXPECT_GE(counts.orientation, 1u);
+  EXPECT_LE(counts.dropped(), 3u);
+  const auto topology = pcl::cocone::analyzeMesh(mesh, P.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.orientation_conflicts, 0u);
+  EXPECT_EQ(topology.components, 1u);
+}
+
 TEST(Reconstruction, Deterministic)
 {
   const auto s = cocone_test::monkeySaddle(options(5000, 0.05));
