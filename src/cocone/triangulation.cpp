@@ -194,9 +194,23 @@ circumcenterOf(const Delaunay& dt, typename Delaunay::Cell_handle c)
   const int corners = cornersOf(dt);
   for (int i = 0; i < corners; ++i)
     s[i] = {c->vertex(i)->info(), &c->vertex(i)->point()};
-  std::sort(s.begin(), s.begin() + corners, [](const auto& a, const auto& b) {
-    return a.first < b.first;
-  });
+  // A sorting network of compare-exchanges (std::sort's call costs more here).
+  const auto order = [&](int a, int b) {
+    if (s[b].first < s[a].first)
+      std::swap(s[a], s[b]);
+  };
+  if (corners == 4) {
+    order(0, 1);
+    order(2, 3);
+    order(0, 2);
+    order(1, 3);
+    order(1, 2);
+  }
+  else {
+    order(0, 1);
+    order(1, 2);
+    order(0, 1);
+  }
   const auto p = [&](int k) {
     const Kernel::Point_3& q = *s[k].second;
     return Eigen::Vector3d(q.x(), q.y(), q.z());
