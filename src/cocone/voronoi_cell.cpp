@@ -185,6 +185,15 @@ planarCells(const Triangulation& dt, double cocone_angle)
   return vc;
 }
 
+/** Per corner of a cell, the bits of its three edges in CellView::edges. */
+constexpr std::array<unsigned, 4> EDGES_AT = [] {
+  std::array<unsigned, 4> at{};
+  for (unsigned e = 0; e < 6; ++e)
+    for (const int i : CellView::EDGE_ENDS[e])
+      at[i] |= 1u << e;
+  return at;
+}();
+
 /** Raise *target to x atomically. */
 void
 atomicMax(double* target, double x)
@@ -320,12 +329,11 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
           if (threads > 1)
             while (__atomic_test_and_set(&lock[v], __ATOMIC_ACQUIRE)) {
             }
-          for (int e = 0; e < 6; ++e) {
-            const auto& ends = CellView::EDGE_ENDS[e];
-            if ((cell.edges & (1u << e)) && (ends[0] == i || ends[1] == i)) {
-              const int j = ends[0] + ends[1] - i;
-              nearest.offer(v, cell.v[j], edge2[i][j]);
-            }
+          // The offered edges at v, in the order of EDGE_ENDS.
+          for (unsigned at = cell.edges & EDGES_AT[i]; at != 0; at &= at - 1) {
+            const auto& ends = CellView::EDGE_ENDS[__builtin_ctz(at)];
+            const int j = ends[0] + ends[1] - i;
+            nearest.offer(v, cell.v[j], edge2[i][j]);
           }
           if (finite && (d2 > far2[v] || (d2 == far2[v] && lexLess(far[v], cc)))) {
             far2[v] = d2;
