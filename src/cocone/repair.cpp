@@ -39,6 +39,19 @@ compact(std::vector<Triangle>& triangles, const std::vector<std::uint8_t>& drop)
   return dropped;
 }
 
+/** The edge incidences of \a triangles: \a known if given and grouped, else grouped
+ * into \a storage. */
+const EdgeIncidences&
+incidencesOf(const std::vector<Triangle>& triangles,
+             const EdgeIncidences* known,
+             EdgeIncidences& storage)
+{
+  if (known && known->grouped())
+    return *known;
+  storage = EdgeIncidences(triangles);
+  return storage;
+}
+
 /** At every edge with more than two triangles keep the best pair. */
 std::size_t
 resolveEdges(const std::vector<Eigen::Vector3d>& P,
@@ -194,7 +207,6 @@ orient(const std::vector<Eigen::Vector3d>& P,
   // A component that can be oriented has one orientation given its seed's: a
   // breadth-first pass finds it, and only where it meets a disagreement does the
   // order matter and the pass run again in Prim's order.
-  std::vector<std::uint8_t> turned(m, 0);
   for (std::size_t s = 0; s < m; ++s, members.clear()) {
     if (component[s] >= 0)
       continue;
@@ -214,20 +226,20 @@ orient(const std::vector<Eigen::Vector3d>& P,
         }
         component[t2] = c;
         members.push_back(t2);
-        if (disagree(t, k)) {
+        if (disagree(t, k))
           turn(t2);
-          turned[t2] = 1;
-        }
       }
     }
+    // Each triangle is turned in its own component's pass only: so far, its turns
+    // are those of the breadth-first pass.
     if (consistent) {
       for (const int t : members)
-        flipped += turned[t];
+        flipped += turned_over[t];
     }
     else {
       normal.resize(m);
       for (const int t : members) {
-        if (turned[t])
+        if (turned_over[t])
           turn(t);
         component[t] = -1;
         normal[t] = unitNormal(P, triangles[t]);
@@ -334,9 +346,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
 {
   const std::size_t num_vertices = points.size();
   EdgeIncidences grouped;
-  if (!incidences || incidences->first.empty())
-    grouped = EdgeIncidences(triangles);
-  const EdgeIncidences& inc = grouped.first.empty() ? *incidences : grouped;
+  const EdgeIncidences& inc = incidencesOf(triangles, incidences, grouped);
   // Hole half-edges run against the border half-edges of the triangles.
   std::vector<int> hole_next(num_vertices, -1);
   std::vector<int> starts;
@@ -438,7 +448,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
     }
   }
   if (added && incidences)
-    *incidences = EdgeIncidences(); // stale: not known any more
+    *incidences = EdgeIncidences(); // stale: no longer grouped
   return added;
 }
 
@@ -448,11 +458,8 @@ dropRibbons(std::vector<Triangle>& triangles,
             EdgeIncidences* incidences)
 {
   std::size_t count = 0;
-  EdgeIncidences inc;
-  if (incidences && !incidences->first.empty())
-    inc = std::move(*incidences);
-  else
-    inc = EdgeIncidences(triangles);
+  EdgeIncidences grouped;
+  const EdgeIncidences& inc = incidencesOf(triangles, incidences, grouped);
   const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
   std::vector<std::uint8_t> on_border(num_vertices, 0);
   for (std::size_t e = 0; e < inc.edges.size(); ++e)
@@ -467,8 +474,10 @@ dropRibbons(std::vector<Triangle>& triangles,
   for (std::size_t t = 0; t < triangles.size(); ++t)
     drop[t] = !inner[component[t]];
   const std::size_t dropped = compact(triangles, drop);
-  if (incidences)
-    *incidences = dropped ? EdgeIncidences(triangles) : std::move(inc);
+  if (incidences && dropped)
+    *incidences = EdgeIncidences(triangles);
+  else if (incidences && &inc == &grouped)
+    *incidences = std::move(grouped);
   return dropped;
 }
 

@@ -194,23 +194,7 @@ circumcenterOf(const Delaunay& dt, typename Delaunay::Cell_handle c)
   const int corners = cornersOf(dt);
   for (int i = 0; i < corners; ++i)
     s[i] = {c->vertex(i)->info(), &c->vertex(i)->point()};
-  // A sorting network of compare-exchanges (std::sort's call costs more here).
-  const auto order = [&](int a, int b) {
-    if (s[b].first < s[a].first)
-      std::swap(s[a], s[b]);
-  };
-  if (corners == 4) {
-    order(0, 1);
-    order(2, 3);
-    order(0, 2);
-    order(1, 3);
-    order(1, 2);
-  }
-  else {
-    order(0, 1);
-    order(1, 2);
-    order(0, 1);
-  }
+  detail::sortCorners(s, corners, [](const auto& corner) { return corner.first; });
   const auto p = [&](int k) {
     const Kernel::Point_3& q = *s[k].second;
     return Eigen::Vector3d(q.x(), q.y(), q.z());
@@ -449,7 +433,7 @@ visitHullFacets(const Triangulation& triangulation,
                         for (int k = 0, m = 0; k < 4; ++k)
                           if (k != j)
                             f[m++] = inside->vertex(k)->info();
-                        std::sort(f.begin(), f.begin() + 3);
+                        detail::sortCorners(f, 3, [](int v) { return v; });
                         f[3] = inside->vertex(j)->info();
                         visitor(context, f);
                       }));

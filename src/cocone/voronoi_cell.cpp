@@ -29,14 +29,7 @@ facetIds(const std::array<int, 4>& cell, int i)
   for (int k = 0, j = 0; k < 4; ++k)
     if (k != i)
       f[j++] = cell[k];
-  // Three compare-exchanges (a sorting network; std::sort's call costs more here).
-  const auto order = [&](int a, int b) {
-    if (f[b] < f[a])
-      std::swap(f[a], f[b]);
-  };
-  order(0, 1);
-  order(1, 2);
-  order(0, 1);
+  detail::sortCorners(f, 3, [](int v) { return v; });
   return f;
 }
 

@@ -24,12 +24,18 @@ struct EdgeIncidences {
   std::vector<int> triangle;             ///< per incidence
   std::vector<std::uint8_t> forward;     ///< per incidence: traverses lower -> higher
 
-  /** None: not grouped yet (first is empty; a grouping of no triangle has one
-   * offset). */
+  /** None: not grouped yet (see grouped()). */
   EdgeIncidences() = default;
 
   /** Group the edges of \a oriented. */
   explicit EdgeIncidences(const std::vector<Triangle>& oriented);
+
+  /** Whether these are a grouping (of no triangle, too) rather than none. */
+  bool
+  grouped() const
+  {
+    return !first.empty();
+  }
 
   /** Number of triangles at edge e. */
   std::size_t
