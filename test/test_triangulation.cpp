@@ -135,9 +135,9 @@ TEST(Triangulate, EveryEdgeStoodForByACellOrOnTheHull)
     slots += 6;
   });
   const std::size_t offers = stood_for.size();
-  forEachHullFacet(dt, [&](const std::array<int, 4>& h) {
+  forEachHullFacet(dt, [&](const HullFacet& h) {
     for (int k = 0; k < 3; ++k)
-      stood_for.push_back(edge(h[k], h[(k + 1) % 3]));
+      stood_for.push_back(edge(h.v[k], h.v[(k + 1) % 3]));
   });
   for (auto* edges : {&all, &stood_for}) {
     std::sort(edges->begin(), edges->end());
@@ -146,6 +146,71 @@ TEST(Triangulate, EveryEdgeStoodForByACellOrOnTheHull)
   EXPECT_EQ(stood_for, all);
   // Far fewer than the six edges of every cell (about a third of them).
   EXPECT_LT(offers, slots / 2) << offers << " of " << slots;
+}
+
+TEST(Triangulate, FacetsFaceAwayFromTheirCellsAndTheHullOutward)
+{
+  // A cube of random points with a near-flat lid: cells flat to rounding on the
+  // hull, where n . (p - p0) in floating point is noise.
+  std::vector<Eigen::Vector3d> P;
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 3000; ++i)
+    P.emplace_back(u(random), u(random), u(random));
+  for (int i = 0; i < 500; ++i)
+    P.emplace_back(u(random), u(random), 2.0 + 1e-13 * u(random));
+  const Triangulation dt = triangulate(makeUniquePoints(P).points);
+  ASSERT_EQ(dt.dimension, 3);
+  const auto& X = dt.points;
+  const auto normal = [&](const std::array<int, 3>& f) {
+    return Eigen::Vector3d((X[f[1]] - X[f[0]]).cross(X[f[2]] - X[f[0]]));
+  };
+  // Each facet's sides as its cells see them: the two cells of an interior facet
+  // opposite, the one cell of a hull facet as the hull facet.
+  std::vector<std::pair<std::array<int, 3>, int>> sides;
+  std::size_t checked = 0;
+  forEachCell(dt, CellView::FACETS, 1, [&](const CellView& c, int) {
+    for (int i = 0; i < 4; ++i) {
+      std::array<int, 3> f;
+      for (int k = 0, m = 0; k < 4; ++k)
+        if (k != i)
+          f[m++] = c.v[k];
+      std::sort(f.begin(), f.end());
+      sides.emplace_back(f, c.outwardSide(i));
+      // Where floating point is sure of the side, the same.
+      const double s = normal(f).dot(X[c.v[i]] - X[f[0]]);
+      if (std::abs(s) > 1e-9) {
+        EXPECT_EQ(c.outwardSide(i), s > 0.0 ? -1 : 1);
+        ++checked;
+      }
+    }
+  });
+  EXPECT_GT(checked, sides.size() * 9 / 10);
+  std::vector<std::pair<std::array<int, 3>, int>> hull;
+  const Eigen::Vector3d inside(0.0, 0.0, 0.5);
+  forEachHullFacet(dt, [&](const HullFacet& h) {
+    hull.emplace_back(h.v, h.outward);
+    // The hull is convex and contains the inside point.
+    EXPECT_GT(h.outward * normal(h.v).dot(X[h.v[0]] - (inside - dt.offset)), 0.0);
+  });
+  std::sort(sides.begin(), sides.end());
+  std::sort(hull.begin(), hull.end());
+  std::size_t interior = 0, h = 0;
+  for (std::size_t k = 0; k < sides.size(); ++k) {
+    if (k + 1 < sides.size() && sides[k + 1].first == sides[k].first) {
+      EXPECT_EQ(sides[k].second, -sides[k + 1].second);
+      ++interior;
+      ++k;
+    }
+    else {
+      ASSERT_LT(h, hull.size());
+      EXPECT_EQ(hull[h], sides[k]);
+      ++h;
+    }
+  }
+  EXPECT_EQ(h, hull.size());
+  EXPECT_EQ(4 * dt.number_of_cells, 2 * interior + hull.size());
+  EXPECT_GT(hull.size(), 100u);
 }
 
 TEST(Triangulate, SameCellsWhateverTheThreads)

@@ -44,6 +44,10 @@ struct Built {
    * cell's facets and the per-vertex records of its vertices are mostly still in
    * cache. */
   std::vector<typename Delaunay::Cell_handle> cells;
+  /** The infinite cells (dimension 3), one per hull facet, in the container's
+   * order: collected while ordering the cells, so the hull is read without a walk
+   * about the infinite vertex. */
+  std::vector<typename Delaunay::Cell_handle> hull;
 };
 
 /** One of the two, as the thread count chose. */

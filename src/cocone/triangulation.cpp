@@ -5,8 +5,6 @@
 
 #include <pcl/surface/cocone/triangulation.h>
 
-#include <boost/iterator/function_output_iterator.hpp>
-
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/spatial_sort.h>
 
@@ -164,6 +162,21 @@ trimMallocArenas()
 #endif
 }
 
+/** Whether v[i] lies where n = (p1 - p0) x (p2 - p0) points, p0, p1, p2 being the
+ * other three vertices of the positively oriented cell v by ascending id: +1 if
+ * the permutation from v to (p0, p1, p2, v[i]) is even, -1 if odd. */
+int
+ascendingParity(const std::array<int, 4>& v, int i)
+{
+  // v[i] moved last: 3 - i transpositions; then the inversions among the rest.
+  std::array<int, 3> rest;
+  for (int k = 0, m = 0; k < 4; ++k)
+    if (k != i)
+      rest[m++] = v[k];
+  const int swaps = 3 - i + (rest[0] > rest[1]) + (rest[0] > rest[2]) + (rest[1] > rest[2]);
+  return swaps % 2 == 0 ? 1 : -1;
+}
+
 /** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
 template <typename Delaunay>
 int
@@ -205,7 +218,7 @@ circumcenterOf(const Delaunay& dt, typename Delaunay::Cell_handle c)
 
 /** Fill structure.cells: the finite cells by their smallest vertex id, in buckets
  * of 64 ids (a few hundred cells: a counting sort with few write positions; inside
- * a bucket the container's order, which does not matter). */
+ * a bucket the container's order, which does not matter); and structure.hull. */
 template <typename Built>
 void
 orderCells(Built& structure, std::size_t number_of_vertices)
@@ -225,6 +238,8 @@ orderCells(Built& structure, std::size_t number_of_vertices)
       lowest >>= BUCKET_BITS;
       ++start[lowest + 1];
     }
+    else if (corners == 4)
+      structure.hull.push_back(c);
     key.push_back(lowest);
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
@@ -401,6 +416,13 @@ Triangulation::release()
 }
 
 int
+CellView::outwardSide(int i) const
+{
+  // The cell lies on the side of its own vertex v[i].
+  return -ascendingParity(v, i);
+}
+
+int
 resolveThreads(unsigned int requested)
 {
 #ifdef _OPENMP
@@ -422,21 +444,30 @@ visitHullFacets(const Triangulation& triangulation,
     return;
   triangulation.structure->visit([&](const auto& built) {
     const auto& dt = built.dt;
-    using Cell_handle = typename std::remove_reference_t<decltype(dt)>::Cell_handle;
-    // The finite facet of each infinite cell, and the vertex across it.
-    dt.incident_cells(dt.infinite_vertex(),
-                      boost::make_function_output_iterator([&](Cell_handle c) {
-                        const int i = c->index(dt.infinite_vertex());
-                        const auto inside = c->neighbor(i);
-                        const int j = inside->index(c);
-                        std::array<int, 4> f;
-                        for (int k = 0, m = 0; k < 4; ++k)
-                          if (k != j)
-                            f[m++] = inside->vertex(k)->info();
-                        detail::sortCorners(f, 3, [](int v) { return v; });
-                        f[3] = inside->vertex(j)->info();
-                        visitor(context, f);
-                      }));
+    const auto& hull = built.hull;
+    constexpr std::size_t AHEAD = 8;
+    for (std::size_t k = 0; k < hull.size(); ++k) {
+      // The cells lie in the container's order, their vertices scattered.
+      if (k + 2 * AHEAD < hull.size())
+        __builtin_prefetch(&*hull[k + 2 * AHEAD]);
+      if (k + AHEAD < hull.size())
+        for (int i = 0; i < 4; ++i)
+          __builtin_prefetch(&*hull[k + AHEAD]->vertex(i));
+      // The finite facet of an infinite cell, which CGAL orients as if the
+      // infinite vertex were a point outside the hull.
+      const auto c = hull[k];
+      const int infinite = c->index(dt.infinite_vertex());
+      std::array<int, 4> ids;
+      for (int i = 0; i < 4; ++i)
+        ids[i] = i == infinite ? -1 : c->vertex(i)->info();
+      HullFacet facet;
+      facet.outward = ascendingParity(ids, infinite);
+      for (int i = 0, m = 0; i < 4; ++i)
+        if (i != infinite)
+          facet.v[m++] = ids[i];
+      detail::sortCorners(facet.v, 3, [](int v) { return v; });
+      visitor(context, facet);
+    }
   });
 }
 

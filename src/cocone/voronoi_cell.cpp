@@ -33,12 +33,14 @@ facetIds(const std::array<int, 4>& cell, int i)
   return f;
 }
 
-/** Outward unit normal of the hull facet f of a cell whose remaining vertex is o. */
+/** Outward unit normal of the hull facet f (ids ascending) whose outside is on the
+ * side \a outward (CellView::outwardSide()). Only the sign depends on it: the same
+ * bits from either cell. */
 Eigen::Vector3d
-outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f, int o)
+outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f, int outward)
 {
   Eigen::Vector3d n = (P[f[1]] - P[f[0]]).cross(P[f[2]] - P[f[0]]);
-  if (n.dot(P[o] - P[f[0]]) > 0.0)
+  if (outward < 0)
     n = -n;
   const double len = n.norm();
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
@@ -347,13 +349,13 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
   constexpr double FIXED = 4294967296.0;
   std::vector<int> slot(n, -1);
   std::vector<std::array<std::int64_t, 3>> sum;
-  forEachHullFacet(dt, [&](const std::array<int, 4>& h) {
-    const Eigen::Vector3d normal = outwardNormal(P, {h[0], h[1], h[2]}, h[3]);
+  forEachHullFacet(dt, [&](const HullFacet& h) {
+    const Eigen::Vector3d normal = outwardNormal(P, h.v, h.outward);
     std::array<std::int64_t, 3> fixed;
     for (int m = 0; m < 3; ++m)
       fixed[m] = std::llround(normal[m] * FIXED);
     for (int k = 0; k < 3; ++k) {
-      const int a = h[k], b = h[(k + 1) % 3];
+      const int a = h.v[k], b = h.v[(k + 1) % 3];
       const float d2 = nearest.distance2(a, b);
       nearest.offer(a, b, d2);
       nearest.offer(b, a, d2);
@@ -450,7 +452,7 @@ computeCocones(const Triangulation& dt,
                   Eigen::Vector3d a = cc, d;
                   const bool ray = cell.facet[i] == FacetRole::HULL;
                   if (ray) {
-                    d = outwardNormal(P, f, cell.v[i]);
+                    d = outwardNormal(P, f, cell.outwardSide(i));
                     // An unbounded Voronoi edge going to the negative side puts
                     // v- at infinity.
                     for (const int v : f)

@@ -136,6 +136,22 @@ struct CellView {
   std::uint8_t edges;
   /** Number of vertices: 4, or 3 in dimension 2. */
   int corners;
+
+  /** On which side of the facet opposite v[i] (dimension 3) the cell is not: +1
+   * where n = (p1 - p0) x (p2 - p0) points for the facet's points p0, p1, p2 by
+   * ascending id, -1 opposite. Exact: CGAL orients every cell positively, so this
+   * is the parity of a permutation, where n . (v[i] - p0) in floating point can
+   * take the wrong sign for a flat cell. */
+  int
+  outwardSide(int i) const;
+};
+
+/** \brief A facet of the convex hull (dimension 3). */
+struct HullFacet {
+  /** Vertex ids, ascending. */
+  std::array<int, 3> v;
+  /** The side where the outside of the hull lies, as in CellView::outwardSide(). */
+  int outward;
 };
 
 namespace detail {
@@ -146,21 +162,20 @@ visitCells(const Triangulation& dt,
            int threads,
            CellVisitor visitor,
            void* context);
-using HullFacetVisitor = void (*)(void* context, const std::array<int, 4>& facet);
+using HullFacetVisitor = void (*)(void* context, const HullFacet& facet);
 void
 visitHullFacets(const Triangulation& dt, HullFacetVisitor visitor, void* context);
 } // namespace detail
 
-/** \brief Call visit(facet) once for every facet on the convex hull (dimension 3):
- * its three vertex ids ascending, then the id of the vertex across it inside the
- * hull. The order of the calls is unspecified. */
+/** \brief Call visit(facet) once for every facet of the convex hull (dimension 3),
+ * a HullFacet. The order of the calls is unspecified. */
 template <typename Visit>
 void
 forEachHullFacet(const Triangulation& dt, Visit&& visit)
 {
   detail::visitHullFacets(
       dt,
-      [](void* context, const std::array<int, 4>& facet) {
+      [](void* context, const HullFacet& facet) {
         (*static_cast<std::remove_reference_t<Visit>*>(context))(facet);
       },
       const_cast<void*>(static_cast<const void*>(&visit)));
