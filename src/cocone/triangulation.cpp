@@ -173,7 +173,8 @@ ascendingParity(const std::array<int, 4>& v, int i)
   for (int k = 0, m = 0; k < 4; ++k)
     if (k != i)
       rest[m++] = v[k];
-  const int swaps = 3 - i + (rest[0] > rest[1]) + (rest[0] > rest[2]) + (rest[1] > rest[2]);
+  const int swaps =
+      3 - i + (rest[0] > rest[1]) + (rest[0] > rest[2]) + (rest[1] > rest[2]);
   return swaps % 2 == 0 ? 1 : -1;
 }
 
@@ -492,11 +493,13 @@ visitCells(const Triangulation& triangulation,
       const void* cell = nullptr;
       Eigen::Vector3d circumcenter;
     };
+    // Without the neighbours every cell is asked for once: no cache.
+    const bool caching = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
     std::vector<std::vector<Entry>> caches(
-        threads,
-        std::vector<Entry>(data & CellView::CIRCUMCENTER ? std::size_t(1) << CACHE_BITS
-                                                         : 0));
+        threads, std::vector<Entry>(caching ? std::size_t(1) << CACHE_BITS : 0));
     const auto cached = [&](std::vector<Entry>& cache, Cell_handle c) {
+      if (!caching)
+        return circumcenterOf(dt, c);
       const auto key = reinterpret_cast<std::uintptr_t>(&*c);
       Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
       if (e.cell != &*c) {

@@ -37,7 +37,9 @@ facetIds(const std::array<int, 4>& cell, int i)
  * side \a outward (CellView::outwardSide()). Only the sign depends on it: the same
  * bits from either cell. */
 Eigen::Vector3d
-outwardNormal(const std::vector<Eigen::Vector3d>& P, const std::array<int, 3>& f, int outward)
+outwardNormal(const std::vector<Eigen::Vector3d>& P,
+              const std::array<int, 3>& f,
+              int outward)
 {
   Eigen::Vector3d n = (P[f[1]] - P[f[0]]).cross(P[f[2]] - P[f[0]]);
   if (outward < 0)
