@@ -342,10 +342,10 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
       });
   std::vector<std::uint8_t>().swap(lock);
 
-  // The convex hull, in one walk about the infinite vertex: its edges, which no cell
-  // need stand for, offered; per hull vertex the sum of the outward normals of its
-  // hull facets, the pole of its unbounded Voronoi cell. The sum is taken in fixed
-  // point: exact, so it does not depend on the walk's order (which follows the
+  // The convex hull, its facets once each: their edges, which no cell need stand
+  // for, offered; per hull vertex the sum of the outward normals of its hull
+  // facets, the pole of its unbounded Voronoi cell. The sum is taken in fixed
+  // point: exact, so it does not depend on the facets' order (which follows the
   // cells' addresses), and 2^-32 is far finer than a pole direction needs. (A
   // sampled closed surface can have half its points on the hull.)
   constexpr double FIXED = 4294967296.0;
