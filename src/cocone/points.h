@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -53,6 +54,30 @@ sortCorners(Array& a, int n, Key key)
     order(1, 2);
     order(0, 1);
   }
+}
+
+/** The facet of cell \a v opposite its vertex v[i]: the other three ids ascending,
+ * and the parity of the permutation from v to (those three, v[i]), +1 even, -1
+ * odd. For a positively oriented cell, +1 means v[i] lies where (p1 - p0) x
+ * (p2 - p0) of the facet's points points: CGAL's orientations, read exactly. */
+struct OppositeFacet {
+  std::array<int, 3> ids;
+  int parity;
+};
+
+inline OppositeFacet
+oppositeFacet(const std::array<int, 4>& v, int i)
+{
+  OppositeFacet f;
+  for (int k = 0, m = 0; k < 4; ++k)
+    if (k != i)
+      f.ids[m++] = v[k];
+  // v[i] moved last: 3 - i transpositions; then the inversions among the rest.
+  const int swaps =
+      3 - i + (f.ids[0] > f.ids[1]) + (f.ids[0] > f.ids[2]) + (f.ids[1] > f.ids[2]);
+  f.parity = swaps % 2 == 0 ? 1 : -1;
+  sortCorners(f.ids, 3, [](int id) { return id; });
+  return f;
 }
 
 } // namespace detail

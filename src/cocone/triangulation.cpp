@@ -162,22 +162,6 @@ trimMallocArenas()
 #endif
 }
 
-/** Whether v[i] lies where n = (p1 - p0) x (p2 - p0) points, p0, p1, p2 being the
- * other three vertices of the positively oriented cell v by ascending id: +1 if
- * the permutation from v to (p0, p1, p2, v[i]) is even, -1 if odd. */
-int
-ascendingParity(const std::array<int, 4>& v, int i)
-{
-  // v[i] moved last: 3 - i transpositions; then the inversions among the rest.
-  std::array<int, 3> rest;
-  for (int k = 0, m = 0; k < 4; ++k)
-    if (k != i)
-      rest[m++] = v[k];
-  const int swaps =
-      3 - i + (rest[0] > rest[1]) + (rest[0] > rest[2]) + (rest[1] > rest[2]);
-  return swaps % 2 == 0 ? 1 : -1;
-}
-
 /** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
 template <typename Delaunay>
 int
@@ -420,7 +404,7 @@ int
 CellView::outwardSide(int i) const
 {
   // The cell lies on the side of its own vertex v[i].
-  return -ascendingParity(v, i);
+  return -detail::oppositeFacet(v, i).parity;
 }
 
 int
@@ -461,13 +445,8 @@ visitHullFacets(const Triangulation& triangulation,
       std::array<int, 4> ids;
       for (int i = 0; i < 4; ++i)
         ids[i] = i == infinite ? -1 : c->vertex(i)->info();
-      HullFacet facet;
-      facet.outward = ascendingParity(ids, infinite);
-      for (int i = 0, m = 0; i < 4; ++i)
-        if (i != infinite)
-          facet.v[m++] = ids[i];
-      detail::sortCorners(facet.v, 3, [](int v) { return v; });
-      visitor(context, facet);
+      const auto opposite = detail::oppositeFacet(ids, infinite);
+      visitor(context, HullFacet{opposite.ids, opposite.parity});
     }
   });
 }
@@ -497,7 +476,7 @@ visitCells(const Triangulation& triangulation,
     const bool caching = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
     std::vector<std::vector<Entry>> caches(
         threads, std::vector<Entry>(caching ? std::size_t(1) << CACHE_BITS : 0));
-    const auto cached = [&](std::vector<Entry>& cache, Cell_handle c) {
+    const auto circumcenter = [&](std::vector<Entry>& cache, Cell_handle c) {
       if (!caching)
         return circumcenterOf(dt, c);
       const auto key = reinterpret_cast<std::uintptr_t>(&*c);
@@ -526,7 +505,7 @@ visitCells(const Triangulation& triangulation,
           __builtin_prefetch(other + 64);
         }
       if (data & CellView::CIRCUMCENTER)
-        view.circumcenter = cached(cache, c);
+        view.circumcenter = circumcenter(cache, c);
       view.edges = 0;
       // The neighbours about an edge lie across the facets opposite the other two
       // vertices; only their addresses are compared, the cells are not loaded.
@@ -551,7 +530,7 @@ visitCells(const Triangulation& triangulation,
         else {
           view.facet[i] = FacetRole::OWN;
           if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS)
-            view.neighbor_circumcenter[i] = cached(cache, other);
+            view.neighbor_circumcenter[i] = circumcenter(cache, other);
         }
       }
       visitor(context, view, thread);

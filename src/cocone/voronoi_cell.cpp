@@ -21,18 +21,6 @@ constexpr double INF = std::numeric_limits<double>::infinity();
 using detail::isFinite;
 using detail::lexLess;
 
-/** The facet of cell c opposite its vertex i, as ascending vertex ids. */
-std::array<int, 3>
-facetIds(const std::array<int, 4>& cell, int i)
-{
-  std::array<int, 3> f;
-  for (int k = 0, j = 0; k < 4; ++k)
-    if (k != i)
-      f[j++] = cell[k];
-  detail::sortCorners(f, 3, [](int v) { return v; });
-  return f;
-}
-
 /** Outward unit normal of the hull facet f (ids ascending) whose outside is on the
  * side \a outward (CellView::outwardSide()). Only the sign depends on it: the same
  * bits from either cell. */
@@ -153,7 +141,7 @@ planarCells(const Triangulation& dt, double cocone_angle)
         }
         // The dual of a planar triangle is the line through its circumcenter along the
         // normal; it passes through the plane, where every co-cone contains it.
-        const auto f = facetIds(cell.v, 3);
+        const auto f = detail::oppositeFacet(cell.v, 3).ids;
         vc.triangles.push_back({f, 7});
         first = std::min(first, f);
       });
@@ -450,7 +438,7 @@ computeCocones(const Triangulation& dt,
                 for (int i = 0; i < 4; ++i) {
                   if (cell.facet[i] == FacetRole::SHARED)
                     continue;
-                  const auto f = facetIds(cell.v, i);
+                  const auto f = detail::oppositeFacet(cell.v, i).ids;
                   Eigen::Vector3d a = cc, d;
                   const bool ray = cell.facet[i] == FacetRole::HULL;
                   if (ray) {
