@@ -2,7 +2,7 @@
 # Install the Debian (bookworm) packages the library, its tests and its tool need.
 # Does nothing when they are all present.
 set -euo pipefail
-packages=(cmake g++ make libpcl-dev libcgal-dev libeigen3-dev libflann-dev libtbb-dev
+packages=(cmake g++ make libpcl-dev libcgal-dev libeigen3-dev libflann-dev
           libgtest-dev pcl-tools xvfb xauth python3-catkin-pkg clang libclang-rt-14-dev
           doxygen)
 missing=()

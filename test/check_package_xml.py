@@ -13,7 +13,7 @@ assert package.licenses == ["GPL-3.0-or-later"], package.licenses
 build_type = [e.content for e in package.exports if e.tagname == "build_type"]
 assert build_type == ["cmake"], build_type
 depends = {d.name for d in package.build_depends}
-for key in ("libpcl-all-dev", "cgal", "eigen", "libflann-dev", "tbb"):
+for key in ("libpcl-all-dev", "cgal", "eigen", "libflann-dev"):
     assert key in depends, key
 assert "gtest" in {d.name for d in package.test_depends}
 print("package.xml: format 3, %s %s, %d build dependencies" %

@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -213,34 +217,84 @@ TEST(Triangulate, FacetsFaceAwayFromTheirCellsAndTheHullOutward)
   EXPECT_GT(hull.size(), 100u);
 }
 
-TEST(Triangulate, SameCellsWhateverTheThreads)
+/** The cells of a triangulation as sorted vertex ids, sorted. */
+std::vector<std::array<int, 4>>
+sortedCells(const Triangulation& dt)
 {
-  // Large enough for the concurrent insertion; half the points on a grid, where
-  // nearly every cell has co-spherical neighbours and only CGAL's symbolic
-  // perturbation makes the triangulation unique.
-  std::vector<Eigen::Vector3d> P;
-  for (int i = 0; i < 40; ++i)
-    for (int j = 0; j < 40; ++j)
-      for (int k = 0; k < 40; ++k)
-        P.emplace_back(i, j, k);
+  std::vector<std::array<int, 4>> out;
+  forEachCell(dt, 0, 1, [&](const CellView& c, int) {
+    auto v = c.v;
+    std::sort(v.begin(), v.end());
+    out.push_back(v);
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/** The same from CGAL's Delaunay_triangulation_3, the reference. */
+std::vector<std::array<int, 4>>
+cgalCells(const std::vector<Eigen::Vector3d>& points)
+{
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Delaunay = CGAL::Delaunay_triangulation_3<
+      K,
+      CGAL::Triangulation_data_structure_3<
+          CGAL::Triangulation_vertex_base_with_info_3<int, K>,
+          CGAL::Delaunay_triangulation_cell_base_3<K>>>;
+  std::vector<std::pair<K::Point_3, int>> sites;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    sites.emplace_back(K::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                       static_cast<int>(i));
+  const Delaunay dt(sites.begin(), sites.end());
+  std::vector<std::array<int, 4>> out;
+  for (const auto c : dt.finite_cell_handles()) {
+    std::array<int, 4> v;
+    for (int i = 0; i < 4; ++i)
+      v[i] = c->vertex(i)->info();
+    std::sort(v.begin(), v.end());
+    out.push_back(v);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(Triangulate, SameCellsAsCgalOnDegenerateInput)
+{
+  // Grid points: nearly every cell has co-spherical neighbours, and most points
+  // reach the hull in the plane of a hull facet, so only CGAL's symbolic
+  // perturbation (of spheres, and of circles on the hull) makes the triangulation
+  // unique. Then points on a sphere of integer radius (all co-spherical), and a
+  // random sample of a torus.
   std::mt19937 random(5);
-  std::uniform_real_distribution<double> u(0.0, 39.0);
-  for (int i = 0; i < 40000; ++i)
-    P.emplace_back(u(random), u(random), u(random));
-  const auto cells = [&](unsigned int threads) {
-    const Triangulation dt = triangulate(makeUniquePoints(P).points, threads);
-    std::vector<std::array<int, 4>> out;
-    forEachCell(dt, 0, 1, [&](const CellView& c, int) {
-      auto v = c.v;
-      std::sort(v.begin(), v.end());
-      out.push_back(v);
-    });
-    std::sort(out.begin(), out.end());
-    return out;
-  };
-  const auto sequential = cells(1);
-  EXPECT_GT(sequential.size(), 5 * P.size());
-  EXPECT_EQ(cells(2), sequential);
+  std::uniform_real_distribution<double> u(0.0, 19.0);
+  std::vector<std::vector<Eigen::Vector3d>> clouds(3);
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j)
+      for (int k = 0; k < 20; ++k)
+        clouds[0].emplace_back(i, j, k);
+  for (int i = 0; i < 4000; ++i)
+    clouds[0].emplace_back(u(random), u(random), u(random));
+  for (int i = -25; i <= 25; ++i)
+    for (int j = -25; j <= 25; ++j)
+      for (int k = -25; k <= 25; ++k)
+        if (i * i + j * j + k * k == 625)
+          clouds[1].emplace_back(i, j, k);
+  clouds[1].emplace_back(0.5, 0.25, 0.125);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
+  for (int i = 0; i < 20000; ++i) {
+    const double a = angle(random), b = angle(random);
+    clouds[2].emplace_back(
+        (3 + std::cos(b)) * std::cos(a), (3 + std::cos(b)) * std::sin(a), std::sin(b));
+  }
+  for (const auto& cloud : clouds) {
+    const std::vector<Eigen::Vector3d> points = makeUniquePoints(cloud).points;
+    const Triangulation dt = triangulate(points);
+    ASSERT_EQ(dt.dimension, 3);
+    const auto cells = sortedCells(dt);
+    EXPECT_GT(cells.size(), points.size());
+    EXPECT_EQ(cells.size(), dt.number_of_cells);
+    EXPECT_TRUE(cells == cgalCells(dt.points));
+  }
 }
 
 TEST(Triangulate, RecentresLargeCoordinates)

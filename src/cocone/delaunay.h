@@ -2,18 +2,17 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * CGAL's Delaunay triangulation as stage 1 keeps it (not installed).
+ * The Delaunay triangulation of stage 1 in flat arrays (not installed).
  */
 
 #pragma once
 
 #include <pcl/surface/cocone/triangulation.h>
 
-#include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
-#include <memory>
+#include <array>
+#include <cstdint>
 #include <vector>
 
 namespace pcl {
@@ -21,60 +20,47 @@ namespace cocone {
 namespace detail {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-/** Vertex info: the vertex id. */
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
-/** Cells as CGAL's default: the circumcenters are recomputed where a pass needs
- * them, which is cheaper than the memory to keep them (about 19 cells per point). */
-using CellBase = CGAL::Delaunay_triangulation_cell_base_3<Kernel>;
-template <typename ConcurrencyTag>
-using DelaunayOf = CGAL::Delaunay_triangulation_3<
-    Kernel,
-    CGAL::Triangulation_data_structure_3<VertexBase, CellBase, ConcurrencyTag>>;
-/** Built by one thread: CGAL's sequential structure, which builds fastest so. */
-using SequentialDelaunay = DelaunayOf<CGAL::Sequential_tag>;
-/** Built by several threads (points inserted concurrently, cells locked). */
-using ParallelDelaunay = DelaunayOf<CGAL::Parallel_tag>;
 
-/** A triangulation and the order in which the passes visit its cells. */
-template <typename Delaunay>
-struct Built {
-  Delaunay dt;
-  /** The finite cells by smallest vertex id. CGAL's container reuses freed slots,
-   * so its order scatters neighbouring cells; in this order the cells across a
-   * cell's facets and the per-vertex records of its vertices are mostly still in
-   * cache. */
-  std::vector<typename Delaunay::Cell_handle> cells;
-  /** The infinite cells (dimension 3), one per hull facet, in the container's
-   * order: collected while ordering the cells, so the hull is read without a walk
-   * about the infinite vertex. */
-  std::vector<typename Delaunay::Cell_handle> hull;
+/** A cell while the triangulation is built: four vertex ids, positively oriented
+ * (INFINITE stands for the vertex at infinity, oriented as if it were a point
+ * outside the hull, as in CGAL), and per facet the cell across it times four plus
+ * the index of the shared facet there. */
+struct BuildCell {
+  static constexpr int INFINITE = -1;
+  /** v[0] of a cell that was freed and not reused. */
+  static constexpr int FREE = -2;
+  std::array<int, 4> v;
+  std::array<std::uint32_t, 4> n;
 };
 
-/** One of the two, as the thread count chose. */
+/** \brief The Delaunay triangulation of points in general position in space, by
+ * Bowyer-Watson insertion in CGAL's spatial order (Hilbert curve, random rounds).
+ *
+ * Every decision is CGAL's filtered exact predicate with CGAL's symbolic
+ * perturbation of co-spherical and co-circular points, so the cells are those of
+ * CGAL's Delaunay_triangulation_3: the Delaunay triangulation is unique under the
+ * perturbation. Kept in two 16-byte arrays per cell instead of CGAL's linked cells,
+ * which halves its memory and lets the passes read cells by index.
+ * \param[in] points unique points
+ * \param[out] cells the cells, finite and infinite, and freed ones (v[0] == FREE)
+ * \return the affine dimension of the points: below 3 the cells are left empty
+ */
+int
+buildDelaunay(const std::vector<Eigen::Vector3d>& points,
+              std::vector<BuildCell>& cells);
+
+/** The triangulation as the passes read it: the finite cells in the order they
+ * are visited, then the infinite ones (dimension 3: one per hull facet). */
 struct DelaunayStructure {
-  std::unique_ptr<Built<SequentialDelaunay>> sequential;
-  std::unique_ptr<Built<ParallelDelaunay>> parallel;
-
-  /** Call f on the one that is built. */
-  template <typename F>
-  void
-  visit(F&& f) const
-  {
-    if (sequential)
-      f(static_cast<const Built<SequentialDelaunay>&>(*sequential));
-    else
-      f(static_cast<const Built<ParallelDelaunay>&>(*parallel));
-  }
-
-  template <typename F>
-  void
-  visit(F&& f)
-  {
-    if (sequential)
-      f(*sequential);
-    else
-      f(*parallel);
-  }
+  /** Vertex ids per cell (INFINITE for the vertex at infinity; dimension 2: the
+   * three corners, then -1). */
+  std::vector<std::array<int, 4>> vertices;
+  /** Per cell, the cell across the facet opposite vertices[c][i]. */
+  std::vector<std::array<int, 4>> neighbors;
+  /** Cells [0, finite) are finite. */
+  std::size_t finite = 0;
+  /** Per finite cell its circumcenter, once a pass has asked for them. */
+  std::vector<Eigen::Vector3d> circumcenters;
 };
 
 } // namespace detail

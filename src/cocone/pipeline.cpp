@@ -153,7 +153,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
     return result;
   }
 
-  Triangulation dt = triangulate(std::move(unique.points), parameters.threads);
+  Triangulation dt = triangulate(std::move(unique.points));
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";

@@ -5,13 +5,12 @@
 
 #include <pcl/surface/cocone/triangulation.h>
 
+#include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
-#include <CGAL/spatial_sort.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include "delaunay.h"
 #include "points.h"
-#include <tbb/scalable_allocator.h>
-#include <tbb/task_arena.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -30,6 +29,7 @@
 #include <numeric>
 #include <thread>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 
 namespace pcl {
@@ -151,9 +151,9 @@ triangleCircumcenter(const Eigen::Vector3d& a,
 
 namespace {
 
-/** Hand glibc's free memory back to the system. What the builder thread and TBB's
- * workers allocated lies in malloc arenas of their own, which glibc keeps mapped
- * after it is freed (a small block left on top of a heap keeps the rest too). */
+/** Hand glibc's free memory back to the system. What the builder thread allocated
+ * lies in a malloc arena of its own, which glibc keeps mapped after it is freed (a
+ * small block left on top of a heap keeps the rest too). */
 void
 trimMallocArenas()
 {
@@ -162,87 +162,99 @@ trimMallocArenas()
 #endif
 }
 
-/** Number of the cell's vertices: 4, or 3 when the triangulation is planar. */
-template <typename Delaunay>
-int
-cornersOf(const Delaunay& dt)
-{
-  return dt.dimension() == 3 ? 4 : 3;
-}
+/** CGAL's triangulation, for coplanar points only (dimension 2: its cells are the
+ * triangles of the planar Delaunay triangulation). */
+using PlanarDelaunay = CGAL::Delaunay_triangulation_3<
+    Kernel,
+    CGAL::Triangulation_data_structure_3<
+        CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>,
+        CGAL::Delaunay_triangulation_cell_base_3<Kernel>>>;
 
-template <typename Delaunay>
-bool
-isFiniteCell(const Delaunay& dt, typename Delaunay::Cell_handle c)
-{
-  for (int i = 0, corners = cornersOf(dt); i < corners; ++i)
-    if (dt.is_infinite(c->vertex(i)))
-      return false;
-  return true;
-}
-
-/** The circumcenter of a finite cell, from its vertices in ascending id order (a
- * canonical order: the result is bitwise reproducible). */
-template <typename Delaunay>
-Eigen::Vector3d
-circumcenterOf(const Delaunay& dt, typename Delaunay::Cell_handle c)
-{
-  // The points are read from CGAL's vertices, which are loaded for their ids
-  // anyway; they hold the same recentred coordinates as Triangulation::points.
-  std::array<std::pair<int, const Kernel::Point_3*>, 4> s;
-  const int corners = cornersOf(dt);
-  for (int i = 0; i < corners; ++i)
-    s[i] = {c->vertex(i)->info(), &c->vertex(i)->point()};
-  detail::sortCorners(s, corners, [](const auto& corner) { return corner.first; });
-  const auto p = [&](int k) {
-    const Kernel::Point_3& q = *s[k].second;
-    return Eigen::Vector3d(q.x(), q.y(), q.z());
-  };
-  return corners == 4 ? tetrahedronCircumcenter(p(0), p(1), p(2), p(3))
-                      : triangleCircumcenter(p(0), p(1), p(2));
-}
-
-/** Fill structure.cells: the finite cells by their smallest vertex id, in buckets
- * of 64 ids (a few hundred cells: a counting sort with few write positions; inside
- * a bucket the container's order, which does not matter); and structure.hull. */
-template <typename Built>
+/** The planar triangulation of coplanar points, as cells of three corners. */
 void
-orderCells(Built& structure, std::size_t number_of_vertices)
+triangulatePlanar(const std::vector<Eigen::Vector3d>& points,
+                  std::vector<detail::BuildCell>& cells)
 {
-  const auto& dt = structure.dt;
-  const int corners = cornersOf(dt);
-  std::vector<int> key;
-  key.reserve(dt.tds().number_of_cells());
-  constexpr int BUCKET_BITS = 6;
-  std::vector<std::uint32_t> start((number_of_vertices >> BUCKET_BITS) + 2, 0);
+  std::vector<std::pair<Kernel::Point_3, int>> sites;
+  sites.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    sites.emplace_back(Kernel::Point_3(points[i].x(), points[i].y(), points[i].z()),
+                       static_cast<int>(i));
+  const PlanarDelaunay dt(sites.begin(), sites.end());
+  std::unordered_map<const void*, std::uint32_t> number;
+  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c)
+    number.emplace(&*c, static_cast<std::uint32_t>(number.size()));
+  cells.resize(number.size());
   for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c) {
-    int lowest = -1;
-    if (isFiniteCell(dt, c)) {
-      lowest = c->vertex(0)->info();
-      for (int i = 1; i < corners; ++i)
-        lowest = std::min(lowest, c->vertex(i)->info());
-      lowest >>= BUCKET_BITS;
-      ++start[lowest + 1];
+    detail::BuildCell& cell = cells[number.at(&*c)];
+    cell.v = {-1, -1, -1, -1};
+    cell.n = {0, 0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+      cell.v[i] = dt.is_infinite(c->vertex(i)) ? detail::BuildCell::INFINITE
+                                               : c->vertex(i)->info();
+      cell.n[i] = 4 * number.at(&*c->neighbor(i));
     }
-    else if (corners == 4)
-      structure.hull.push_back(c);
-    key.push_back(lowest);
+  }
+}
+
+/** Keep the cells in the order the passes visit them: the finite cells by smallest
+ * vertex id, in buckets of 64 ids (a counting sort with few write positions; inside
+ * a bucket the builder's order, which does not matter), then the infinite ones. In
+ * this order the cells across a cell's facets and the per-vertex records of its
+ * vertices are mostly in cache when a pass needs them. */
+void
+orderCells(const std::vector<detail::BuildCell>& built,
+           int corners,
+           std::size_t number_of_vertices,
+           detail::DelaunayStructure& out)
+{
+  constexpr int BUCKET_BITS = 6;
+  constexpr int FREE = -1;
+  const int infinite = static_cast<int>(number_of_vertices >> BUCKET_BITS) + 1;
+  std::vector<std::uint32_t> start(infinite + 2, 0);
+  // Per built cell its bucket, then its place.
+  std::vector<int> slot(built.size(), FREE);
+  for (std::size_t c = 0; c < built.size(); ++c) {
+    const auto& v = built[c].v;
+    if (v[0] == detail::BuildCell::FREE)
+      continue;
+    int lowest = v[0];
+    for (int i = 1; i < corners; ++i)
+      lowest = (lowest < 0 || v[i] < 0) ? -1 : std::min(lowest, v[i]);
+    slot[c] = lowest < 0 ? infinite : lowest >> BUCKET_BITS;
+    ++start[slot[c] + 1];
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
-  structure.cells.resize(start.back());
-  auto k = key.begin();
-  for (auto c = dt.tds().raw_cells_begin(); c != dt.tds().raw_cells_end(); ++c, ++k)
-    if (*k >= 0)
-      structure.cells[start[*k]++] = c;
+  out.finite = start[infinite];
+  for (int& s : slot)
+    if (s != FREE)
+      s = static_cast<int>(start[s]++);
+  out.vertices.resize(start.back());
+  out.neighbors.resize(start.back());
+  for (std::size_t c = 0; c < built.size(); ++c) {
+    if (slot[c] == FREE)
+      continue;
+    auto& v = out.vertices[slot[c]];
+    auto& n = out.neighbors[slot[c]];
+    v = built[c].v;
+    for (int i = 0; i < 4; ++i)
+      n[i] = i < corners ? slot[built[c].n[i] >> 2] : -1;
+  }
 }
 
-/** Run body(cell, thread) over the finite cells, split in equal runs per thread. */
-template <typename Built, typename Body>
-void
-splitCells(const Built& structure, int threads, const Body& body)
+/** Number of the cells' corners: 4, or 3 when the triangulation is planar. */
+int
+cornersOf(const Triangulation& dt)
 {
-  using Cell_handle = typename decltype(Built::dt)::Cell_handle;
-  constexpr std::size_t AHEAD = 8;
-  const int corners = cornersOf(structure.dt);
+  return dt.dimension == 3 ? 4 : 3;
+}
+
+/** Run body(first, end, thread) over the finite cells, split in equal runs per
+ * thread. */
+template <typename Body>
+void
+splitCells(std::size_t count, int threads, const Body& body)
+{
   // An exception must not leave a parallel region: it is caught in the thread and
   // thrown again after the region (only std::bad_alloc can occur here).
   bool failed = false;
@@ -253,28 +265,8 @@ splitCells(const Built& structure, int threads, const Body& body)
 #else
     const int thread = 0, team = 1;
 #endif
-    const std::size_t count = structure.cells.size();
-    const std::size_t begin = count * thread / team, end = count * (thread + 1) / team;
     try {
-      for (std::size_t k = begin; k < end; ++k) {
-        // The cells lie scattered in memory: fetch ahead, the cell first, then its
-        // vertices once the cell has arrived; the body gets a cell further on still
-        // whose vertices have arrived, to fetch its own records.
-        if (k + 3 * AHEAD < end) {
-          const char* ahead =
-              reinterpret_cast<const char*>(&*structure.cells[k + 3 * AHEAD]);
-          __builtin_prefetch(ahead);
-          __builtin_prefetch(ahead + 64);
-        }
-        if (k + 2 * AHEAD < end) {
-          const auto c = structure.cells[k + 2 * AHEAD];
-          for (int i = 0; i < corners; ++i)
-            __builtin_prefetch(&*c->vertex(i));
-        }
-        body(structure.cells[k],
-             k + AHEAD < end ? structure.cells[k + AHEAD] : Cell_handle(),
-             thread);
-      }
+      body(count * thread / team, count * (thread + 1) / team, thread);
     }
     catch (const std::bad_alloc&) {
       __atomic_store_n(&failed, true, __ATOMIC_RELAXED);
@@ -284,10 +276,30 @@ splitCells(const Built& structure, int threads, const Body& body)
     throw std::bad_alloc();
 }
 
+/** The circumcenters of the finite cells, from their vertices in ascending id
+ * order (a canonical order: the result is bitwise reproducible). */
+void
+computeCircumcenters(const Triangulation& dt, int threads)
+{
+  auto& s = *dt.structure;
+  const int corners = cornersOf(dt);
+  s.circumcenters.resize(s.finite);
+  splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t k = begin; k < end; ++k) {
+      std::array<int, 4> v = s.vertices[k];
+      detail::sortCorners(v, corners, [](int id) { return id; });
+      const auto& P = dt.points;
+      s.circumcenters[k] =
+          corners == 4 ? tetrahedronCircumcenter(P[v[0]], P[v[1]], P[v[2]], P[v[3]])
+                       : triangleCircumcenter(P[v[0]], P[v[1]], P[v[2]]);
+    }
+  });
+}
+
 } // namespace
 
 Triangulation
-triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
+triangulate(std::vector<Eigen::Vector3d> points)
 {
   Triangulation out;
   if (points.empty())
@@ -302,61 +314,16 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
     p -= out.offset;
   out.points = std::move(points);
 
-  std::vector<std::pair<Kernel::Point_3, int>> sites;
-  sites.reserve(out.points.size());
-  for (std::size_t i = 0; i < out.points.size(); ++i) {
-    const auto& p = out.points[i];
-    sites.emplace_back(Kernel::Point_3(p.x(), p.y(), p.z()), static_cast<int>(i));
-  }
-  out.structure = std::make_shared<detail::DelaunayStructure>();
-  const int threads = resolveThreads(num_threads);
-  // Concurrent insertion pays off only on large clouds; the grid of 100^3 locks
-  // was the fastest measured on a million points (10^3: blocked most of the time).
-  // One thread builds CGAL's sequential structure, which is faster so.
-  const bool concurrent = threads > 1 && sites.size() >= 100000;
-  // One thread: CGAL's spatial sort (Hilbert order with random rounds, seeded) and
-  // insertion with the previous vertex as the hint, what range insertion does minus
-  // its indirection through an index array. Several: CGAL's range insertion, which
-  // sorts in parallel itself. CGAL's symbolic perturbation makes the triangulation
-  // of degenerate (co-spherical) input independent of the order.
-  if (concurrent)
-    out.structure->parallel =
-        std::make_unique<detail::Built<detail::ParallelDelaunay>>();
-  else {
-    CGAL::spatial_sort(
-        sites.begin(),
-        sites.end(),
-        CGAL::Spatial_sort_traits_adapter_3<
-            Kernel,
-            CGAL::First_of_pair_property_map<std::pair<Kernel::Point_3, int>>>());
-    out.structure->sequential =
-        std::make_unique<detail::Built<detail::SequentialDelaunay>>();
-  }
   // CGAL's insertion keeps scratch tables in thread-local storage that an exception
   // (std::bad_alloc) leaves dirty, which breaks every later insertion in the same
   // thread. Building in a thread of its own confines that state to this call.
+  std::vector<detail::BuildCell> cells;
   std::exception_ptr failure;
   std::thread builder([&]() {
     try {
-      if (concurrent) {
-        auto& dt = out.structure->parallel->dt;
-        CGAL::Bbox_3 box;
-        for (const auto& site : sites)
-          box += site.first.bbox();
-        detail::ParallelDelaunay::Lock_data_structure locks(box, 100);
-        dt.set_lock_data_structure(&locks);
-        tbb::task_arena arena(threads);
-        arena.execute([&]() { dt.insert(sites.begin(), sites.end()); });
-        dt.set_lock_data_structure(nullptr);
-      }
-      else {
-        auto& dt = out.structure->sequential->dt;
-        detail::SequentialDelaunay::Vertex_handle hint;
-        for (const auto& site : sites) {
-          hint = dt.insert(site.first, hint);
-          hint->info() = site.second;
-        }
-      }
+      out.dimension = detail::buildDelaunay(out.points, cells);
+      if (out.dimension == 2)
+        triangulatePlanar(out.points, cells);
     }
     catch (...) {
       failure = std::current_exception();
@@ -365,38 +332,22 @@ triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads)
   builder.join();
   if (failure)
     std::rethrow_exception(failure);
-  std::vector<std::pair<Kernel::Point_3, int>>().swap(sites);
-  // Before the passes add their arrays on top (measured peak on a million saddle
-  // points: 1005 -> 962 MB with two threads, 945 -> 928 MB with one).
-  trimMallocArenas();
-  out.structure->visit(
-      [&](const auto& built) { out.dimension = built.dt.dimension(); });
-  if (out.dimension < 2) {
-    out.release();
+  if (out.dimension < 2)
     return out;
-  }
 
-  out.structure->visit([&](auto& built) {
-    orderCells(built, out.points.size());
-    out.number_of_cells = built.cells.size();
-  });
+  out.structure = std::make_shared<detail::DelaunayStructure>();
+  orderCells(cells, cornersOf(out), out.points.size(), *out.structure);
+  std::vector<detail::BuildCell>().swap(cells);
+  // Before the passes add their arrays on top.
+  trimMallocArenas();
+  out.number_of_cells = out.structure->finite;
   return out;
 }
 
 void
 Triangulation::release()
 {
-  if (!structure)
-    return;
-  const bool concurrent = structure->parallel != nullptr;
   structure.reset();
-  // The concurrent structure's cells come from TBB's allocator, which keeps freed
-  // blocks for reuse: hand them back. (Only then: TBB's allocator must not be
-  // asked before it has served anything.)
-  if (concurrent)
-    scalable_allocation_command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
-  // And glibc's (measured: peak 1.41 GB instead of 0.96 GB on a million saddle
-  // points, two threads).
   trimMallocArenas();
 }
 
@@ -421,120 +372,83 @@ resolveThreads(unsigned int requested)
 namespace detail {
 
 void
-visitHullFacets(const Triangulation& triangulation,
-                HullFacetVisitor visitor,
-                void* context)
+visitHullFacets(const Triangulation& dt, HullFacetVisitor visitor, void* context)
 {
-  if (!triangulation.structure || triangulation.dimension != 3)
+  if (!dt.structure || dt.dimension != 3)
     return;
-  triangulation.structure->visit([&](const auto& built) {
-    const auto& dt = built.dt;
-    const auto& hull = built.hull;
-    constexpr std::size_t AHEAD = 8;
-    for (std::size_t k = 0; k < hull.size(); ++k) {
-      // The cells lie in the container's order, their vertices scattered.
-      if (k + 2 * AHEAD < hull.size())
-        __builtin_prefetch(&*hull[k + 2 * AHEAD]);
-      if (k + AHEAD < hull.size())
-        for (int i = 0; i < 4; ++i)
-          __builtin_prefetch(&*hull[k + AHEAD]->vertex(i));
-      // The finite facet of an infinite cell, which CGAL orients as if the
-      // infinite vertex were a point outside the hull.
-      const auto c = hull[k];
-      const int infinite = c->index(dt.infinite_vertex());
-      std::array<int, 4> ids;
-      for (int i = 0; i < 4; ++i)
-        ids[i] = i == infinite ? -1 : c->vertex(i)->info();
-      const auto opposite = detail::oppositeFacet(ids, infinite);
-      visitor(context, HullFacet{opposite.ids, opposite.parity});
-    }
-  });
+  const auto& s = *dt.structure;
+  for (std::size_t c = s.finite; c < s.vertices.size(); ++c) {
+    // The finite facet of an infinite cell, which is oriented as if the infinite
+    // vertex were a point outside the hull.
+    const auto& v = s.vertices[c];
+    const int infinite = static_cast<int>(
+        std::find(v.begin(), v.end(), BuildCell::INFINITE) - v.begin());
+    const auto opposite = oppositeFacet(v, infinite);
+    visitor(context, HullFacet{opposite.ids, opposite.parity});
+  }
 }
 
 void
-visitCells(const Triangulation& triangulation,
+visitCells(const Triangulation& dt,
            unsigned int data,
            int threads,
            CellVisitor visitor,
            void* context)
 {
-  if (!triangulation.structure)
+  if (!dt.structure)
     return;
-  triangulation.structure->visit([&](const auto& built) {
-    const auto& dt = built.dt;
-    using Cell_handle = typename std::remove_reference_t<decltype(dt)>::Cell_handle;
-    const int corners = cornersOf(dt);
-    // A small direct-mapped cache of circumcenters per thread: the cells across a
-    // cell's facets were mostly created, and are visited, close to it, and computing
-    // a circumcenter again costs mainly the cache misses of loading that cell.
-    constexpr int CACHE_BITS = 14;
-    struct Entry {
-      const void* cell = nullptr;
-      Eigen::Vector3d circumcenter;
-    };
-    // Without the neighbours every cell is asked for once: no cache.
-    const bool caching = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
-    std::vector<std::vector<Entry>> caches(
-        threads, std::vector<Entry>(caching ? std::size_t(1) << CACHE_BITS : 0));
-    const auto circumcenter = [&](std::vector<Entry>& cache, Cell_handle c) {
-      if (!caching)
-        return circumcenterOf(dt, c);
-      const auto key = reinterpret_cast<std::uintptr_t>(&*c);
-      Entry& e = cache[(key * 0x9e3779b97f4a7c15ULL) >> (64 - CACHE_BITS)];
-      if (e.cell != &*c) {
-        e.cell = &*c;
-        e.circumcenter = circumcenterOf(dt, c);
-      }
-      return e.circumcenter;
-    };
-    splitCells(built, threads, [&](Cell_handle c, Cell_handle ahead, int thread) {
-      auto& cache = caches[thread];
-      CellView view;
-      view.corners = corners;
-      view.v = {-1, -1, -1, -1};
+  auto& s = *dt.structure;
+  const int corners = cornersOf(dt);
+  if ((data & CellView::CIRCUMCENTER) && s.circumcenters.empty())
+    computeCircumcenters(dt, threads);
+  const bool neighbors = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
+  if (neighbors && s.circumcenters.empty())
+    computeCircumcenters(dt, threads);
+  const int finite = static_cast<int>(s.finite);
+  splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
+    constexpr std::size_t AHEAD = 8;
+    CellView view;
+    view.corners = corners;
+    for (std::size_t k = begin; k < end; ++k) {
+      const int c = static_cast<int>(k);
+      const auto& across = s.neighbors[k];
+      view.v = s.vertices[k];
       view.ahead = {-1, -1, -1, -1};
-      for (int i = 0; i < corners; ++i) {
-        view.v[i] = c->vertex(i)->info();
-        if (ahead != Cell_handle())
-          view.ahead[i] = ahead->vertex(i)->info();
+      if (k + AHEAD < end) {
+        view.ahead = s.vertices[k + AHEAD];
+        if (neighbors)
+          for (int i = 0; i < corners; ++i) {
+            const int other = s.neighbors[k + AHEAD][i];
+            if (other < finite)
+              __builtin_prefetch(&s.circumcenters[other]);
+          }
       }
-      if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS && ahead != Cell_handle())
-        for (int i = 0; i < corners; ++i) {
-          const char* other = reinterpret_cast<const char*>(&*ahead->neighbor(i));
-          __builtin_prefetch(other);
-          __builtin_prefetch(other + 64);
-        }
+      if (corners == 3)
+        view.v[3] = view.ahead[3] = -1;
       if (data & CellView::CIRCUMCENTER)
-        view.circumcenter = circumcenter(cache, c);
+        view.circumcenter = s.circumcenters[k];
       view.edges = 0;
       // The neighbours about an edge lie across the facets opposite the other two
-      // vertices; only their addresses are compared, the cells are not loaded.
+      // vertices.
       for (int e = 0; (data & CellView::EDGES) && corners == 4 && e < 6; ++e) {
-        const auto& across = CellView::EDGE_ENDS[5 - e];
-        if (&*c < &*c->neighbor(across[0]) && &*c < &*c->neighbor(across[1]))
+        const auto& ends = CellView::EDGE_ENDS[5 - e];
+        if (c < across[ends[0]] && c < across[ends[1]])
           view.edges |= static_cast<std::uint8_t>(1u << e);
       }
       for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
-        if (i >= corners) {
+        // Each interior facet once: from the cell visited later.
+        if (i >= corners || across[i] >= finite)
           view.facet[i] = FacetRole::HULL;
-          continue;
-        }
-        const auto other = c->neighbor(i);
-        // Each interior facet once: from the cell at the higher address
-        // (which one does not matter to the visitors; both are visited
-        // close together, so the other's circumcenter is mostly cached).
-        if (!isFiniteCell(dt, other))
-          view.facet[i] = FacetRole::HULL;
-        else if (&*other > &*c)
+        else if (across[i] > c)
           view.facet[i] = FacetRole::SHARED;
         else {
           view.facet[i] = FacetRole::OWN;
-          if ((data & CellView::NEIGHBORS) == CellView::NEIGHBORS)
-            view.neighbor_circumcenter[i] = circumcenter(cache, other);
+          if (neighbors)
+            view.neighbor_circumcenter[i] = s.circumcenters[across[i]];
         }
       }
       visitor(context, view, thread);
-    });
+    }
   });
 }
 

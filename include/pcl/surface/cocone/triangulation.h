@@ -41,15 +41,14 @@ struct DelaunayStructure;
 
 /** \brief Stage 1: the Delaunay triangulation (exact predicates).
  *
- * The cells stay in CGAL's structure while the passes of stages 2 and 4 run over
- * them (forEachCell()), in an order of their own kept beside them (one handle per
- * cell, by smallest vertex id: neighbouring cells and their vertices' records are
- * visited close together); then release() frees it. A copy into flat arrays, or a
- * stored circumcenter per cell, would raise the peak memory of the whole pipeline
- * by a half: random samples have about 14 cells per point, and CGAL's structure
- * is the largest thing the pipeline holds. The circumcenters (the Voronoi vertices)
- * are recomputed where a pass needs them instead, always from the vertices in
- * ascending id order, so that every pass sees the same bits.
+ * The cells (random samples of a surface have about 14 per point) are kept in flat
+ * arrays, four vertex ids and four neighbours per cell, in the order the passes of
+ * stages 2 and 4 visit them (forEachCell()): by smallest vertex id, so neighbouring
+ * cells and their vertices' records are visited close together. The first pass
+ * that asks for circumcenters (the Voronoi vertices) computes them once, from the
+ * vertices in ascending id order so that the bits are reproducible; release()
+ * frees it all. In these arrays the cells and their circumcenters take about as
+ * much memory as CGAL's linked cells alone.
  *
  * When the points are coplanar (dimension 2) the cells are the triangles of the
  * planar Delaunay triangulation.
@@ -63,7 +62,7 @@ struct Triangulation {
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   /** Number of finite cells (tetrahedra, or triangles in dimension 2). */
   std::size_t number_of_cells = 0;
-  /** CGAL's triangulation with the circumcenters; null once released. */
+  /** The cells and their circumcenters; null once released. */
   std::shared_ptr<detail::DelaunayStructure> structure;
 
   /** Free the cells (the points stay) and hand their memory back to the system. */
@@ -73,19 +72,17 @@ struct Triangulation {
 
 /** \brief Triangulate unique points (stage 1).
  *
- * With several threads the points are inserted concurrently (CGAL's parallel
- * Delaunay triangulation, cells locked through a grid over the bounding box). The
- * Delaunay triangulation of a point set is unique (CGAL's symbolic perturbation
- * settles co-spherical points by the points alone), so the cells are the same
- * whatever the thread count; only their order in memory differs, which no pass
- * depends on.
+ * Points in space are inserted one by one in CGAL's spatial order (Bowyer-Watson,
+ * one thread); every decision is one of CGAL's filtered exact predicates, with
+ * CGAL's symbolic perturbation of co-spherical points, so the cells are exactly
+ * those of CGAL's Delaunay_triangulation_3 (the Delaunay triangulation is unique
+ * under that perturbation). Coplanar points are triangulated by CGAL.
  * \param[in] points unique points (see makeUniquePoints); vertex v of the result
  *            is points[v]. Taken by value: move them in and they become the
  *            result's recentred points without a copy.
- * \param[in] num_threads threads to use, 0 for all processors
  */
 Triangulation
-triangulate(std::vector<Eigen::Vector3d> points, unsigned int num_threads = 1);
+triangulate(std::vector<Eigen::Vector3d> points);
 
 /** \brief A thread count: \a requested, or all processors for 0 (PCL's
  * convention). */
