@@ -364,7 +364,9 @@ private:
     if (edges_.size() < size)
       edges_.assign(size, Edge{});
     ++stamp_;
-    const std::size_t mask = edges_.size() - 1;
+    // Probe only the first size slots: the table keeps the size of the largest hole
+    // so far, a small hole stays in a few cache lines.
+    const std::size_t mask = size - 1;
     int last = -1;
     for (const BoundaryFacet& b : boundary_) {
       const int id = allocate();
