@@ -329,13 +329,14 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
         }
       });
   std::vector<std::uint8_t>().swap(lock);
+  nearest.release();
 
-  // The convex hull, its facets once each: their edges, which no cell need stand
-  // for, offered; per hull vertex the sum of the outward normals of its hull
-  // facets, the pole of its unbounded Voronoi cell. The sum is taken in fixed
-  // point: exact, so it does not depend on the facets' order (which follows the
-  // cells' addresses), and 2^-32 is far finer than a pole direction needs. (A
-  // sampled closed surface can have half its points on the hull.)
+  // The convex hull, its facets once each: per hull vertex the sum of the outward
+  // normals of its hull facets, the pole of its unbounded Voronoi cell. The sum is
+  // taken in fixed point: exact, so it does not depend on the facets' order (the
+  // order the triangulation made them in), and 2^-32 is far finer than a pole
+  // direction needs. (A sampled closed surface can have half its points on the
+  // hull.)
   constexpr double FIXED = 4294967296.0;
   std::vector<int> slot(n, -1);
   std::vector<std::array<std::int64_t, 3>> sum;
@@ -344,11 +345,7 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
     std::array<std::int64_t, 3> fixed;
     for (int m = 0; m < 3; ++m)
       fixed[m] = std::llround(normal[m] * FIXED);
-    for (int k = 0; k < 3; ++k) {
-      const int a = h.v[k], b = h.v[(k + 1) % 3];
-      const float d2 = nearest.distance2(a, b);
-      nearest.offer(a, b, d2);
-      nearest.offer(b, a, d2);
+    for (const int a : h.v) {
       if (slot[a] < 0) {
         slot[a] = static_cast<int>(sum.size());
         sum.push_back({0, 0, 0});
@@ -358,7 +355,6 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
         sum[slot[a]][m] += fixed[m];
     }
   });
-  nearest.release();
 
   for (std::size_t v = 0; v < n; ++v) {
     const Eigen::Vector3d normal =

@@ -125,11 +125,10 @@ struct CellView {
    * asked. */
   std::array<Eigen::Vector3d, 4> neighbor_circumcenter;
   /** Bit e set: this cell stands for edge EDGE_ENDS[e], if EDGES was asked
-   * (dimension 3). Of the cells around an edge, those whose two neighbours about it
-   * lie at higher addresses stand for it: at least one (the lowest) unless the ring
-   * contains an infinite cell, i.e. unless the edge lies on the convex hull; about
-   * a third of them in general. A pass that needs every Delaunay edge once or more
-   * reads these and the edges of the hull facets (forEachHullFacet()). */
+   * (dimension 3). Of the finite cells around an edge, those whose two neighbours
+   * about it are visited later (an infinite cell counts as later) stand for it: at
+   * least one, the first visited, so a pass that needs every Delaunay edge once or
+   * more reads these; about a third of the cells in general. */
   std::uint8_t edges;
   /** Number of vertices: 4, or 3 in dimension 2. */
   int corners;
