@@ -151,9 +151,9 @@ triangleCircumcenter(const Eigen::Vector3d& a,
 
 namespace {
 
-/** Hand glibc's free memory back to the system. What the builder thread allocated
- * lies in a malloc arena of its own, which glibc keeps mapped after it is freed (a
- * small block left on top of a heap keeps the rest too). */
+/** Hand glibc's free memory back to the system: glibc keeps freed blocks mapped (a
+ * small block left on top of a heap keeps the rest too), and what CGAL's planar
+ * triangulation allocated lies in the malloc arena of the thread that built it. */
 void
 trimMallocArenas()
 {
@@ -314,24 +314,26 @@ triangulate(std::vector<Eigen::Vector3d> points)
     p -= out.offset;
   out.points = std::move(points);
 
-  // CGAL's insertion keeps scratch tables in thread-local storage that an exception
-  // (std::bad_alloc) leaves dirty, which breaks every later insertion in the same
-  // thread. Building in a thread of its own confines that state to this call.
   std::vector<detail::BuildCell> cells;
-  std::exception_ptr failure;
-  std::thread builder([&]() {
-    try {
-      out.dimension = detail::buildDelaunay(out.points, cells);
-      if (out.dimension == 2)
+  out.dimension = detail::buildDelaunay(out.points, cells);
+  if (out.dimension == 2) {
+    // CGAL's insertion keeps scratch tables in thread-local storage that an
+    // exception (std::bad_alloc) leaves dirty, which breaks every later insertion in
+    // the same thread. Building in a thread of its own confines that state to this
+    // call.
+    std::exception_ptr failure;
+    std::thread planar([&]() {
+      try {
         triangulatePlanar(out.points, cells);
-    }
-    catch (...) {
-      failure = std::current_exception();
-    }
-  });
-  builder.join();
-  if (failure)
-    std::rethrow_exception(failure);
+      }
+      catch (...) {
+        failure = std::current_exception();
+      }
+    });
+    planar.join();
+    if (failure)
+      std::rethrow_exception(failure);
+  }
   if (out.dimension < 2)
     return out;
 
