@@ -153,6 +153,14 @@ private:
     return key;
   }
 
+  /** CGAL's order of the symbolic perturbation: lexicographic, the largest point
+   * perturbed most. */
+  static bool
+  perturbationOrder(const Point* a, const Point* b)
+  {
+    return Kernel::Compare_xyz_3()(*a, *b) == CGAL::SMALLER;
+  }
+
   /** CGAL's Delaunay_triangulation_3::side_of_oriented_sphere with its symbolic
    * perturbation, for a positively oriented cell: > 0 inside. */
   int
@@ -167,9 +175,7 @@ private:
       return side;
     // Co-spherical: perturb the points, the lexicographically largest most.
     std::array<const Point*, 5> sorted{&p0, &p1, &p2, &p3, &p};
-    std::sort(sorted.begin(), sorted.end(), [](const Point* a, const Point* b) {
-      return Kernel::Compare_xyz_3()(*a, *b) == CGAL::SMALLER;
-    });
+    std::sort(sorted.begin(), sorted.end(), perturbationOrder);
     const Kernel::Orientation_3 orientation;
     for (int i = 4; i > 2; --i) {
       if (sorted[i] == &p)
@@ -199,9 +205,7 @@ private:
     if (side != CGAL::ON_BOUNDARY)
       return side;
     std::array<const Point*, 4> sorted{&p0, &p1, &p2, &p};
-    std::sort(sorted.begin(), sorted.end(), [](const Point* a, const Point* b) {
-      return Kernel::Compare_xyz_3()(*a, *b) == CGAL::SMALLER;
-    });
+    std::sort(sorted.begin(), sorted.end(), perturbationOrder);
     const Kernel::Coplanar_orientation_3 orientation;
     const int local = orientation(p0, p1, p2);
     for (int i = 3; i > 0; --i) {
@@ -224,10 +228,7 @@ private:
   bool
   inConflict(const std::array<int, 4>& v, const Point& p) const
   {
-    int i3 = -1;
-    for (int i = 0; i < 4; ++i)
-      if (v[i] == INFINITE)
-        i3 = i;
+    const int i3 = infiniteCorner(v);
     if (i3 < 0)
       return sideOfOrientedSphere(
                  point(v[0]), point(v[1]), point(v[2]), point(v[3]), p) > 0;
@@ -255,10 +256,7 @@ private:
     int previous = -1;
     for (;;) {
       const BuildCell& cell = cells_[c];
-      int i3 = -1;
-      for (int i = 0; i < 4; ++i)
-        if (cell.v[i] == INFINITE)
-          i3 = i;
+      const int i3 = infiniteCorner(cell.v);
       if (i3 >= 0) {
         if (inConflict(cell.v, p))
           return c;
@@ -267,21 +265,9 @@ private:
         c = static_cast<int>(cell.n[i3] >> 2);
         continue;
       }
-      const int r = nextRandom();
-      std::array<const Point*, 4> q{
-          &point(cell.v[0]), &point(cell.v[1]), &point(cell.v[2]), &point(cell.v[3])};
-      int next = -1;
-      for (int k = 0; k < 4 && next < 0; ++k) {
-        const int i = (r + k) & 3;
-        const int other = static_cast<int>(cell.n[i] >> 2);
-        if (other == previous)
-          continue;
-        const Point* own = q[i];
-        q[i] = &p;
-        if (orientation(*q[0], *q[1], *q[2], *q[3]) == CGAL::NEGATIVE)
-          next = other;
-        q[i] = own;
-      }
+      const int next = step(cell, p, previous, [&](const auto& q) {
+        return orientation(*q[0], *q[1], *q[2], *q[3]) == CGAL::NEGATIVE;
+      });
       if (next < 0)
         return c;
       previous = c;
@@ -289,39 +275,53 @@ private:
     }
   }
 
+  /** One step of a walk from finite cell \a cell: the cell across the first facet,
+   * tried from a random one, that p lies beyond, i.e. where \a negative says the
+   * cell's corners with p in place of the facet's opposite vertex are negatively
+   * oriented; the cell the walk came from is skipped. -1 if p lies beyond none. */
+  template <typename Negative>
+  int
+  step(const BuildCell& cell, const Point& p, int previous, const Negative& negative)
+  {
+    const int r = nextRandom();
+    std::array<const Point*, 4> q{
+        &point(cell.v[0]), &point(cell.v[1]), &point(cell.v[2]), &point(cell.v[3])};
+    for (int k = 0; k < 4; ++k) {
+      const int i = (r + k) & 3;
+      const int other = static_cast<int>(cell.n[i] >> 2);
+      if (other == previous)
+        continue;
+      const Point* own = q[i];
+      q[i] = &p;
+      const bool beyond = negative(q);
+      q[i] = own;
+      if (beyond)
+        return other;
+    }
+    return -1;
+  }
+
   int
   roughWalk(const Point& p, int c)
   {
     int previous = -1;
-    for (int step = 0; step < 1000; ++step) {
+    for (int steps = 0; steps < 1000; ++steps) {
       const BuildCell& cell = cells_[c];
       if ((cell.v[0] | cell.v[1] | cell.v[2] | cell.v[3]) < 0)
         return c;
       for (const std::uint32_t across : cell.n)
         __builtin_prefetch(&cells_[across >> 2]);
-      const int r = nextRandom();
-      std::array<const Point*, 4> q{
-          &point(cell.v[0]), &point(cell.v[1]), &point(cell.v[2]), &point(cell.v[3])};
-      int next = -1;
-      for (int k = 0; k < 4 && next < 0; ++k) {
-        const int i = (r + k) & 3;
-        const int other = static_cast<int>(cell.n[i] >> 2);
-        if (other == previous)
-          continue;
-        const Point* own = q[i];
-        q[i] = &p;
+      const int next = step(cell, p, previous, [](const auto& q) {
         const double ax = q[1]->x() - q[0]->x(), ay = q[1]->y() - q[0]->y(),
                      az = q[1]->z() - q[0]->z();
         const double bx = q[2]->x() - q[0]->x(), by = q[2]->y() - q[0]->y(),
                      bz = q[2]->z() - q[0]->z();
         const double cx = q[3]->x() - q[0]->x(), cy = q[3]->y() - q[0]->y(),
                      cz = q[3]->z() - q[0]->z();
-        q[i] = own;
-        if (ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) +
-                az * (bx * cy - by * cx) <
-            0.0)
-          next = other;
-      }
+        return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) +
+                   az * (bx * cy - by * cx) <
+               0.0;
+      });
       if (next < 0)
         return c;
       previous = c;

@@ -33,6 +33,16 @@ struct BuildCell {
   std::array<std::uint32_t, 4> n;
 };
 
+/** The index of the vertex at infinity in a cell's vertices, -1 for a finite cell. */
+inline int
+infiniteCorner(const std::array<int, 4>& v)
+{
+  for (int i = 0; i < 4; ++i)
+    if (v[i] == BuildCell::INFINITE)
+      return i;
+  return -1;
+}
+
 /** \brief The Delaunay triangulation of points in general position in space, by
  * Bowyer-Watson insertion in CGAL's spatial order (Hilbert curve, random rounds).
  *

@@ -383,9 +383,7 @@ visitHullFacets(const Triangulation& dt, HullFacetVisitor visitor, void* context
     // The finite facet of an infinite cell, which is oriented as if the infinite
     // vertex were a point outside the hull.
     const auto& v = s.vertices[c];
-    const int infinite = static_cast<int>(
-        std::find(v.begin(), v.end(), BuildCell::INFINITE) - v.begin());
-    const auto opposite = oppositeFacet(v, infinite);
+    const auto opposite = oppositeFacet(v, infiniteCorner(v));
     visitor(context, HullFacet{opposite.ids, opposite.parity});
   }
 }
@@ -425,8 +423,6 @@ visitCells(const Triangulation& dt,
               __builtin_prefetch(&s.circumcenters[other]);
           }
       }
-      if (corners == 3)
-        view.v[3] = view.ahead[3] = -1;
       if (data & CellView::CIRCUMCENTER)
         view.circumcenter = s.circumcenters[k];
       view.edges = 0;
