@@ -4,10 +4,13 @@
  */
 
 #include <pcl/surface/cocone/boundary.h>
+#include <pcl/surface/cocone/complex.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 using namespace pcl::cocone;
@@ -99,6 +102,33 @@ TEST(DetectBoundary, PoleLinesNotVectors)
   vc.pole[3] = -tilted(0);
   vc.triangles.push_back({{0, 2, 3}, 0b001});
   EXPECT_TRUE(detectBoundary(vc, {1.5, M_PI / 6}).flat[3]);
+}
+
+TEST(LargestAngularGap, SameAsSortingTheAngles)
+{
+  // The gap found without sorting is one of the sorted angles' gaps, and the largest:
+  // few angles (two share one extreme), ties, angles on a coarse grid.
+  const auto sorted_gap = [](std::vector<double> a) {
+    std::sort(a.begin(), a.end());
+    double gap = a.front() + 2.0 * M_PI - a.back();
+    for (std::size_t i = 1; i < a.size(); ++i)
+      gap = std::max(gap, a[i] - a[i - 1]);
+    return gap;
+  };
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<double> a(2 + trial % 40);
+    for (double& x : a)
+      x = angle(random);
+    if (trial % 3 == 0)
+      for (double& x : a)
+        x = std::round(x * 4.0) / 4.0;
+    ASSERT_EQ(largestAngularGap(a), sorted_gap(a)) << a.size() << " angles";
+  }
+  EXPECT_EQ(largestAngularGap({0.5}), 2.0 * M_PI);
+  EXPECT_DOUBLE_EQ(largestAngularGap({1.0, 1.0, 1.0}), 2.0 * M_PI);
+  EXPECT_DOUBLE_EQ(largestAngularGap({-3.0, 3.0}), 6.0);
 }
 
 TEST(HalfDiskTest, GridBorderAndInterior)

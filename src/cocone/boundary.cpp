@@ -4,6 +4,7 @@
  */
 
 #include <pcl/surface/cocone/boundary.h>
+#include <pcl/surface/cocone/complex.h>
 
 #include <algorithm>
 #include <array>
@@ -89,11 +90,7 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
         const Eigen::Vector3d d = points[q] - points[p];
         angles.push_back(std::atan2(d.dot(e2), d.dot(e1)));
       }
-      std::sort(angles.begin(), angles.end());
-      double gap = angles.front() + 2.0 * M_PI - angles.back();
-      for (std::size_t k = 1; k < angles.size(); ++k)
-        gap = std::max(gap, angles[k] - angles[k - 1]);
-      out.gap[p] = gap;
+      out.gap[p] = largestAngularGap(angles);
     }
   }
   // Inside a surface the gaps grow with the irregularity of the sample: the median

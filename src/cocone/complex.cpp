@@ -11,17 +11,43 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace pcl {
 namespace cocone {
 
 double
-largestAngularGap(std::vector<double>& angles)
+largestAngularGap(const std::vector<double>& angles)
 {
-  std::sort(angles.begin(), angles.end());
-  double gap = angles.front() + 2.0 * M_PI - angles.back();
-  for (std::size_t i = 1; i < angles.size(); ++i)
-    gap = std::max(gap, angles[i] - angles[i - 1]);
+  const std::size_t k = angles.size();
+  if (k < 2)
+    return 2.0 * M_PI;
+  const auto [lo, hi] = std::minmax_element(angles.begin(), angles.end());
+  double gap = *lo + 2.0 * M_PI - *hi; // the gap across +-pi
+  if (!(*hi > *lo))
+    return gap;
+  // k buckets of equal width from the lowest angle to the highest: the largest of
+  // the k - 1 gaps between them is wider than a bucket, so it lies between the
+  // highest angle of a bucket and the lowest of the next one that is not empty. No
+  // sort: linear in k.
+  const std::size_t m = k;
+  thread_local std::vector<std::pair<double, double>> bucket; // lowest, highest
+  bucket.assign(m,
+                {std::numeric_limits<double>::infinity(),
+                 -std::numeric_limits<double>::infinity()});
+  const double scale = static_cast<double>(m) / (*hi - *lo);
+  for (const double a : angles) {
+    auto& b = bucket[std::min(m - 1, static_cast<std::size_t>((a - *lo) * scale))];
+    b.first = std::min(b.first, a);
+    b.second = std::max(b.second, a);
+  }
+  double previous = bucket[0].second; // holds the lowest angle
+  for (std::size_t b = 1; b < m; ++b)
+    if (bucket[b].first <= bucket[b].second) {
+      gap = std::max(gap, bucket[b].first - previous);
+      previous = bucket[b].second;
+    }
   return gap;
 }
 

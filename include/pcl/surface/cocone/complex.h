@@ -145,9 +145,10 @@ private:
   std::vector<int> vertex_triangles_;
 };
 
-/** \brief Largest circular gap between angles (radians); sorts \a angles. */
+/** \brief Largest circular gap between angles in [-pi, pi] (radians): 2 pi for
+ * fewer than two. */
 double
-largestAngularGap(std::vector<double>& angles);
+largestAngularGap(const std::vector<double>& angles);
 
 template <typename Alive>
 bool
