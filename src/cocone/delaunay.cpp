@@ -10,6 +10,7 @@
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 
 #include <algorithm>
+#include <limits>
 #include <new>
 #include <utility>
 
@@ -60,17 +61,34 @@ public:
     mark_.assign(cells_.size(), 0);
   }
 
-  /** Insert vertex q, walking from cell \a start; returns a cell of the new star. */
-  int
-  insert(int q, int start)
+  /** Insert vertex q. */
+  void
+  insert(int q)
   {
     const Point& p = point(q);
+    int start = 0;
+    // Start from the cell of the previous point's star whose corners are nearest to
+    // p on average, not from any cell of it: about a point of a sampled surface the
+    // cells are thin, and a walk from the far side circles the point.
+    double best = std::numeric_limits<double>::infinity();
+    for (const int c : star_) {
+      const auto& v = cells_[c].v;
+      if ((v[0] | v[1] | v[2] | v[3]) < 0)
+        continue;
+      Eigen::Vector3d sum(-4.0 * p.x(), -4.0 * p.y(), -4.0 * p.z());
+      for (const int w : v)
+        sum += Eigen::Vector3d(point(w).x(), point(w).y(), point(w).z());
+      if (sum.squaredNorm() < best) {
+        best = sum.squaredNorm();
+        start = c;
+      }
+    }
     const int first = locate(p, start);
     // A point already there (the points should be unique) stays out: a cell of
     // four distinct points cannot be flat.
     for (const int v : cells_[first].v)
       if (v != INFINITE && point(v) == p)
-        return first;
+        return;
     stack_.clear();
     conflict_.clear();
     touched_.clear();
@@ -110,7 +128,7 @@ public:
       cells_[c].n[0] = static_cast<std::uint32_t>(free_);
       free_ = c;
     }
-    return starHole();
+    starHole();
   }
 
 private:
@@ -355,7 +373,7 @@ private:
 
   /** Fill the hole with one new cell per boundary facet; new cells meet along the
    * hole's boundary edges, each shared by two of them, matched in a hash table. */
-  int
+  void
   starHole()
   {
     std::size_t size = 16;
@@ -367,7 +385,7 @@ private:
     // Probe only the first size slots: the table keeps the size of the largest hole
     // so far, a small hole stays in a few cache lines.
     const std::size_t mask = size - 1;
-    int last = -1;
+    star_.clear();
     for (const BoundaryFacet& b : boundary_) {
       const int id = allocate();
       BuildCell& cell = cells_[id];
@@ -400,9 +418,8 @@ private:
           }
         }
       }
-      last = id;
+      star_.push_back(id);
     }
-    return last;
   }
 
   struct Edge {
@@ -415,6 +432,8 @@ private:
   std::vector<BuildCell>& cells_;
   std::vector<std::uint8_t> mark_;
   std::vector<int> stack_, conflict_, touched_;
+  /** The cells made by the latest insertion. */
+  std::vector<int> star_;
   std::vector<BoundaryFacet> boundary_;
   std::vector<Edge> edges_;
   std::uint32_t stamp_ = 0;
@@ -474,10 +493,9 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, std::vector<BuildCell>&
   cells.reserve(std::size_t(n) * 16);
   Builder builder(points, cells);
   builder.start({order[0], order[1], order[third], order[fourth]});
-  int hint = 0;
   for (int k = 2; k < n; ++k)
     if (k != third && k != fourth)
-      hint = builder.insert(order[k], hint);
+      builder.insert(order[k]);
   return 3;
 }
 
