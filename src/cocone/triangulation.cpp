@@ -19,6 +19,10 @@
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
+#ifdef __linux__
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -162,6 +166,28 @@ trimMallocArenas()
 #endif
 }
 
+/** Hand the pages of \a cells past the first \a keep cells back to the system (their
+ * contents are not needed any more); the address space stays. */
+void
+releaseTail(std::vector<detail::BuildCell>& cells, std::size_t keep)
+{
+#ifdef __linux__
+  // Whole pages only, in bytes from the start of the array.
+  char* const base = reinterpret_cast<char*>(cells.data());
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  const std::size_t skew = reinterpret_cast<std::uintptr_t>(base) % page;
+  const std::size_t from = std::min(keep, cells.size()) * sizeof(detail::BuildCell);
+  const std::size_t to = cells.size() * sizeof(detail::BuildCell);
+  const std::size_t first = (from + skew + page - 1) / page * page - skew;
+  const std::size_t last = (to + skew) / page * page;
+  if (last > skew && first < last - skew)
+    madvise(base + first, last - skew - first, MADV_DONTNEED);
+#else
+  (void)cells;
+  (void)keep;
+#endif
+}
+
 /** CGAL's triangulation, for coplanar points only (dimension 2: its cells are the
  * triangles of the planar Delaunay triangulation). */
 using PlanarDelaunay = CGAL::Delaunay_triangulation_3<
@@ -283,7 +309,13 @@ computeCircumcenters(const Triangulation& dt, int threads)
 {
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
-  s.circumcenters.resize(s.finite);
+  // Into the built cells' memory (trivial objects: reusing it ends their lifetime).
+  const std::size_t bytes = s.finite * sizeof(Eigen::Vector3d);
+  s.build.clear();
+  if (s.build.capacity() * sizeof(detail::BuildCell) < bytes)
+    std::vector<detail::BuildCell>(bytes / sizeof(detail::BuildCell) + 1).swap(s.build);
+  s.circumcenters = reinterpret_cast<Eigen::Vector3d*>(s.build.data());
+  std::uninitialized_default_construct_n(s.circumcenters, s.finite);
   splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t k = begin; k < end; ++k) {
       std::array<int, 4> v = s.vertices[k];
@@ -339,8 +371,12 @@ triangulate(std::vector<Eigen::Vector3d> points)
 
   out.structure = std::make_shared<detail::DelaunayStructure>();
   orderCells(cells, cornersOf(out), out.points.size(), *out.structure);
-  std::vector<detail::BuildCell>().swap(cells);
-  // Before the passes add their arrays on top.
+  // The built cells' memory waits for the circumcenters; what they will not need
+  // goes back to the system before the passes add their arrays on top.
+  out.structure->build = std::move(cells);
+  releaseTail(
+      out.structure->build,
+      out.structure->finite * sizeof(Eigen::Vector3d) / sizeof(detail::BuildCell) + 1);
   trimMallocArenas();
   out.number_of_cells = out.structure->finite;
   return out;
@@ -399,10 +435,10 @@ visitCells(const Triangulation& dt,
     return;
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
-  if ((data & CellView::CIRCUMCENTER) && s.circumcenters.empty())
+  if ((data & CellView::CIRCUMCENTER) && !s.circumcenters)
     computeCircumcenters(dt, threads);
   const bool neighbors = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
-  if (neighbors && s.circumcenters.empty())
+  if (neighbors && !s.circumcenters)
     computeCircumcenters(dt, threads);
   const int finite = static_cast<int>(s.finite);
   splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
