@@ -66,10 +66,11 @@ public:
   insert(int q)
   {
     const Point& p = point(q);
-    int start = 0;
-    // Start from the cell of the previous point's star whose corners are nearest to
-    // p on average, not from any cell of it: about a point of a sampled surface the
-    // cells are thin, and a walk from the far side circles the point.
+    // Start from the finite cell of the previous point's star whose corners are
+    // nearest to p on average, not from any cell of it: about a point of a sampled
+    // surface the cells are thin, and a walk from the far side circles the point.
+    // (Cell 0, the first tetrahedron, is alive until the first insertion.)
+    int start = star_.empty() ? 0 : star_.front();
     double best = std::numeric_limits<double>::infinity();
     for (const int c : star_) {
       const auto& v = cells_[c].v;
