@@ -48,19 +48,18 @@ largestAngularGap(const std::vector<double>& angles)
   // the k - 1 gaps between them is wider than a bucket, so it lies between the
   // highest angle of a bucket and the lowest of the next one that is not empty. No
   // sort: linear in k.
-  const std::size_t m = k;
   thread_local std::vector<std::pair<double, double>> bucket; // lowest, highest
-  bucket.assign(m,
+  bucket.assign(k,
                 {std::numeric_limits<double>::infinity(),
                  -std::numeric_limits<double>::infinity()});
-  const double scale = static_cast<double>(m) / (*hi - *lo);
+  const double scale = static_cast<double>(k) / (*hi - *lo);
   for (const double a : angles) {
-    auto& b = bucket[std::min(m - 1, static_cast<std::size_t>((a - *lo) * scale))];
+    auto& b = bucket[std::min(k - 1, static_cast<std::size_t>((a - *lo) * scale))];
     b.first = std::min(b.first, a);
     b.second = std::max(b.second, a);
   }
   double previous = bucket[0].second; // holds the lowest angle
-  for (std::size_t b = 1; b < m; ++b)
+  for (std::size_t b = 1; b < k; ++b)
     if (bucket[b].first <= bucket[b].second) {
       gap = std::max(gap, bucket[b].first - previous);
       previous = bucket[b].second;

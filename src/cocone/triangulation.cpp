@@ -166,6 +166,15 @@ trimMallocArenas()
 #endif
 }
 
+/** The number of built cells whose memory holds the circumcenters of \a finite
+ * cells (a circumcenter takes less than a cell, so never more than were built). */
+std::size_t
+circumcenterCells(std::size_t finite)
+{
+  return (finite * sizeof(Eigen::Vector3d) + sizeof(detail::BuildCell) - 1) /
+         sizeof(detail::BuildCell);
+}
+
 /** Hand the pages of \a cells past the first \a keep cells back to the system (their
  * contents are not needed any more); the address space stays. */
 void
@@ -310,10 +319,8 @@ computeCircumcenters(const Triangulation& dt, int threads)
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
   // Into the built cells' memory (trivial objects: reusing it ends their lifetime).
-  const std::size_t bytes = s.finite * sizeof(Eigen::Vector3d);
   s.build.clear();
-  if (s.build.capacity() * sizeof(detail::BuildCell) < bytes)
-    std::vector<detail::BuildCell>(bytes / sizeof(detail::BuildCell) + 1).swap(s.build);
+  s.build.reserve(circumcenterCells(s.finite));
   s.circumcenters = reinterpret_cast<Eigen::Vector3d*>(s.build.data());
   std::uninitialized_default_construct_n(s.circumcenters, s.finite);
   splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
@@ -374,9 +381,7 @@ triangulate(std::vector<Eigen::Vector3d> points)
   // The built cells' memory waits for the circumcenters; what they will not need
   // goes back to the system before the passes add their arrays on top.
   out.structure->build = std::move(cells);
-  releaseTail(
-      out.structure->build,
-      out.structure->finite * sizeof(Eigen::Vector3d) / sizeof(detail::BuildCell) + 1);
+  releaseTail(out.structure->build, circumcenterCells(out.structure->finite));
   trimMallocArenas();
   out.number_of_cells = out.structure->finite;
   return out;
@@ -435,10 +440,8 @@ visitCells(const Triangulation& dt,
     return;
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
-  if ((data & CellView::CIRCUMCENTER) && !s.circumcenters)
-    computeCircumcenters(dt, threads);
   const bool neighbors = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
-  if (neighbors && !s.circumcenters)
+  if (((data & CellView::CIRCUMCENTER) || neighbors) && !s.circumcenters)
     computeCircumcenters(dt, threads);
   const int finite = static_cast<int>(s.finite);
   splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
