@@ -358,22 +358,24 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       hole_next[b] = a;
       starts.push_back(b);
     }
-  // The mesh's triangles as sorted triples, made for the first hole to fill (a
-  // closed surface has none, and a border loop is mostly longer than a hole).
-  std::vector<Triangle> present;
-  const auto make_present = [&]() {
-    present.reserve(triangles.size());
-    for (auto t : triangles) {
-      std::sort(t.begin(), t.end());
-      present.push_back(t);
-    }
-    std::sort(present.begin(), present.end());
+  // Edge ab of the mesh as it was before the filling: its id, or -1.
+  const auto edge_id = [&](int a, int b) {
+    const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
+    const auto it = std::lower_bound(inc.edges.begin(), inc.edges.end(), key);
+    return it != inc.edges.end() && *it == key ? it - inc.edges.begin() : -1;
   };
-  const auto is_edge = [&](int a, int b) {
-    return std::binary_search(inc.edges.begin(),
-                              inc.edges.end(),
-                              std::array<int, 2>{std::min(a, b), std::max(a, b)});
+  // Whether the mesh had triangle abc: one of the triangles at ab has c.
+  const auto had = [&](int a, int b, int c) {
+    const auto e = edge_id(a, b);
+    if (e >= 0)
+      for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i) {
+        const Triangle& t = triangles[inc.triangle[i]];
+        if (t[0] == c || t[1] == c || t[2] == c)
+          return true;
+      }
+    return false;
   };
+  const std::size_t before = triangles.size();
   std::sort(starts.begin(), starts.end());
   std::vector<std::uint8_t> done(num_vertices, 0);
   std::vector<int> loop;
@@ -393,8 +395,6 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
     const std::size_t k = loop.size();
     if (k < 3 || k > max_edges || hole_next[loop.back()] != x)
       continue;
-    if (present.empty())
-      make_present();
     // The triangulation of the hole's polygon by allowed triangles with the least
     // total perimeter (dynamic programming over the polygon); no new edge may
     // already be in the mesh.
@@ -402,14 +402,14 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       Triangle key{loop[i], loop[m], loop[j]};
       std::sort(key.begin(), key.end());
       if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
-          std::binary_search(present.begin(), present.end(), key))
+          had(loop[i], loop[m], loop[j]))
         return false;
       const auto diagonal = [&](std::size_t a, std::size_t b) {
         return b - a >= 2 && !(a == 0 && b == k - 1);
       };
-      return !(diagonal(i, m) && is_edge(loop[i], loop[m])) &&
-             !(diagonal(m, j) && is_edge(loop[m], loop[j])) &&
-             !(diagonal(i, j) && is_edge(loop[i], loop[j]));
+      return !(diagonal(i, m) && edge_id(loop[i], loop[m]) >= 0) &&
+             !(diagonal(m, j) && edge_id(loop[m], loop[j]) >= 0) &&
+             !(diagonal(i, j) && edge_id(loop[i], loop[j]) >= 0);
     };
     const double inf = std::numeric_limits<double>::infinity();
     cost.assign(k * k, inf);
@@ -447,8 +447,8 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       stack.push_back({m, j});
     }
   }
-  if (added && incidences)
-    *incidences = EdgeIncidences(); // stale: no longer grouped
+  if (added && incidences && incidences->grouped())
+    incidences->add(triangles, before);
   return added;
 }
 

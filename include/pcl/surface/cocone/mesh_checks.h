@@ -30,6 +30,12 @@ struct EdgeIncidences {
   /** Group the edges of \a oriented. */
   explicit EdgeIncidences(const std::vector<Triangle>& oriented);
 
+  /** Group in the triangles \a oriented [from, end) too, as if grouped with the
+   * others from the start (the triangles before \a from are those grouped). Linear
+   * in the edges: cheaper than grouping all again when a few are added. */
+  void
+  add(const std::vector<Triangle>& oriented, std::size_t from);
+
   /** Whether these are a grouping (of no triangle, too) rather than none. */
   bool
   grouped() const

@@ -75,7 +75,8 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
  * leaves it; it stays one (each hole is a simple loop, as every vertex has one fan,
  * and its triangles run against the loop), so no repair is needed afterwards.
  * \param[in,out] incidences if given and not empty, the edge incidences of
- *                \a triangles (grouped here otherwise); emptied if triangles are added
+ *                \a triangles (grouped here otherwise); on return those of the
+ *                filled mesh
  * \return the number of triangles added
  */
 std::size_t
