@@ -293,6 +293,57 @@ TEST(Triangulate, SameCellsAsCgalOnDegenerateInput)
   }
 }
 
+TEST(Triangulate, SameCellsWithSeveralThreads)
+{
+  // Enough points that every thread gets a stretch of the curve (ten thousand
+  // each): a grid (co-spherical points everywhere: only the symbolic perturbation
+  // decides), a torus sample (a surface, as scans are), a random volume.
+  std::mt19937 random(11);
+  std::vector<std::vector<Eigen::Vector3d>> clouds(3);
+  for (int i = 0; i < 36; ++i)
+    for (int j = 0; j < 36; ++j)
+      for (int k = 0; k < 36; ++k)
+        clouds[0].emplace_back(i, j, k);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), u(0.0, 1.0);
+  for (int i = 0; i < 45000; ++i) {
+    const double a = angle(random), b = angle(random);
+    clouds[1].emplace_back(
+        (3 + std::cos(b)) * std::cos(a), (3 + std::cos(b)) * std::sin(a), std::sin(b));
+    clouds[2].emplace_back(u(random), u(random), u(random));
+  }
+  for (const auto& cloud : clouds) {
+    const std::vector<Eigen::Vector3d> points = makeUniquePoints(cloud).points;
+    const auto alone = sortedCells(triangulate(points, 1));
+    for (const int threads : {2, 3, 4}) {
+      const Triangulation dt = triangulate(points, threads);
+      ASSERT_EQ(dt.dimension, 3);
+      EXPECT_TRUE(sortedCells(dt) == alone) << threads << " threads";
+      // The neighbours: every interior facet between two cells that share it.
+      std::size_t hull = 0, own = 0, shared = 0, far = 0;
+      forEachCell(dt,
+                  CellView::CIRCUMCENTER | CellView::NEIGHBORS,
+                  1,
+                  [&](const CellView& c, int) {
+                    for (int i = 0; i < 4; ++i) {
+                      hull += c.facet[i] == FacetRole::HULL;
+                      shared += c.facet[i] == FacetRole::SHARED;
+                      if (c.facet[i] != FacetRole::OWN)
+                        continue;
+                      ++own;
+                      const Eigen::Vector3d& n = c.neighbor_circumcenter[i];
+                      const double r = (n - dt.points[c.v[(i + 1) % 4]]).norm();
+                      for (const int k : {2, 3})
+                        far += std::abs((n - dt.points[c.v[(i + k) % 4]]).norm() - r) >
+                               1e-9 * r;
+                    }
+                  });
+      EXPECT_EQ(own, shared);
+      EXPECT_EQ(4 * dt.number_of_cells, hull + 2 * own);
+      EXPECT_EQ(far, 0u);
+    }
+  }
+}
+
 TEST(Triangulate, RecentresLargeCoordinates)
 {
   std::vector<Eigen::Vector3d> P{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};

@@ -10,8 +10,12 @@
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
+#include <memory>
 #include <new>
+#include <system_error>
+#include <thread>
 #include <utility>
 
 namespace pcl {
@@ -23,13 +27,40 @@ namespace {
 using Point = Kernel::Point_3;
 constexpr int INFINITE = BuildCell::INFINITE;
 
+/** What the builders of one triangulation share: the cells, and per cell a state
+ * that says who holds it. With several threads inserting at once, a cell is read or
+ * written only by the builder that holds it. */
+struct SharedCells {
+  explicit SharedCells(BuildCells& c) : cells(c) {}
+
+  /** A live cell that no builder holds. */
+  static constexpr std::uint8_t FREE_TO_TAKE = 0;
+  /** A freed cell, or one not handed out yet: not part of the triangulation. */
+  static constexpr std::uint8_t DEAD = 0xff;
+
+  BuildCells& cells;
+  /** Per cell: FREE_TO_TAKE, DEAD, or the holder's tag or'ed with its mark. */
+  std::vector<std::uint8_t> state;
+  /** Cells [0, used) have been handed out to the builders, in blocks. */
+  std::atomic<std::size_t> used{0};
+};
+
 /** Bowyer-Watson insertion: find the cells whose circumsphere contains the new
  * point (its conflict region, a star-shaped hole), free them and fill the hole with
  * a cone of new cells from its boundary facets to the point. */
 class Builder {
 public:
-  Builder(const std::vector<Point>& points, std::vector<BuildCell>& cells)
-  : points_(points), cells_(cells)
+  /** \param[in] id this builder's number, below 63
+   *  \param[in] concurrent whether other builders insert at the same time */
+  Builder(const std::vector<Point>& points,
+          SharedCells& shared,
+          int id,
+          bool concurrent)
+  : points_(points)
+  , shared_(shared)
+  , cells_(shared.cells)
+  , tag_(static_cast<std::uint8_t>((id + 1) << 2))
+  , concurrent_(concurrent)
   {}
 
   /** Start from a tetrahedron of four points and its four infinite cells. */
@@ -39,38 +70,114 @@ public:
     if (Kernel::Orientation_3()(point(s[0]), point(s[1]), point(s[2]), point(s[3])) ==
         CGAL::NEGATIVE)
       std::swap(s[0], s[1]);
-    BuildCell first;
-    first.v = s;
-    cells_.push_back(first);
+    reserveCells(5);
+    std::array<int, 5> c;
+    for (int& x : c)
+      x = allocate();
+    cells_[c[0]].v = s;
     // The infinite cell across the facet opposite s[i]: that facet's other side,
     // so two of its vertices trade places.
     for (int i = 0; i < 4; ++i) {
-      BuildCell outside;
-      outside.v = s;
-      outside.v[i] = INFINITE;
-      std::swap(outside.v[(i + 1) & 3], outside.v[(i + 2) & 3]);
-      cells_.push_back(outside);
+      auto& v = cells_[c[i + 1]].v;
+      v = s;
+      v[i] = INFINITE;
+      std::swap(v[(i + 1) & 3], v[(i + 2) & 3]);
     }
     // Adjacencies by matching vertex sets: five cells, done once.
     for (int x = 0; x < 5; ++x)
       for (int i = 0; i < 4; ++i)
         for (int y = 0; y < 5; ++y)
           for (int j = 0; y != x && j < 4; ++j)
-            if (facetKey(cells_[x].v, i) == facetKey(cells_[y].v, j))
-              cells_[x].n[i] = static_cast<std::uint32_t>(y * 4 + j);
-    mark_.assign(cells_.size(), 0);
+            if (facetKey(cells_[c[x]].v, i) == facetKey(cells_[c[y]].v, j))
+              cells_[c[x]].n[i] = static_cast<std::uint32_t>(c[y] * 4 + j);
+    for (const int x : c)
+      letGo(x);
+    start_ = c[0];
   }
 
-  /** Insert vertex q. */
-  void
-  insert(int q)
+  /** Insert vertex q. False, with nothing changed, if a cell that the insertion
+   * needs is held by another builder. \a next: the vertex this builder inserts
+   * next (-1 if none), which the next walk starts towards. */
+  bool
+  insert(int q, int next)
   {
     const Point& p = point(q);
-    // Start from the finite cell of the previous point's star whose corners are
-    // nearest to p on average, not from any cell of it: about a point of a sampled
-    // surface the cells are thin, and a walk from the far side circles the point.
-    // (Cell 0, the first tetrahedron, is alive until the first insertion.)
-    int start = star_.empty() ? 0 : star_.front();
+    const int first = locate(p);
+    if (first < 0)
+      return false;
+    // A point already there (the points should be unique) stays out: a cell of
+    // four distinct points cannot be flat.
+    for (const int v : cells_[first].v)
+      if (v != INFINITE && point(v) == p) {
+        letGo(first);
+        return true;
+      }
+    stack_.clear();
+    conflict_.clear();
+    touched_.clear();
+    boundary_.clear();
+    prefetchNeighbors(first);
+    stack_.push_back(first);
+    conflict_.push_back(first);
+    mark(first, IN_CONFLICT);
+    while (!stack_.empty()) {
+      const int c = stack_.back();
+      stack_.pop_back();
+      for (int i = 0; i < 4; ++i) {
+        const std::uint32_t across = cells_[c].n[i];
+        const int other = static_cast<int>(across >> 2);
+        const std::uint8_t seen = stateOf(other);
+        if (seen == (tag_ | IN_CONFLICT))
+          continue;
+        if (seen != (tag_ | OUTSIDE)) {
+          if (!take(other, OUTSIDE))
+            return abandon();
+          if (inConflict(cells_[other].v, p)) {
+            mark(other, IN_CONFLICT);
+            prefetchNeighbors(other);
+            stack_.push_back(other);
+            conflict_.push_back(other);
+            continue;
+          }
+          touched_.push_back(other);
+        }
+        boundary_.push_back({cells_[c].v, i, across});
+        boundary_.back().v[i] = q;
+      }
+    }
+    // The conflict cells are reused first: the rest must be at hand before any
+    // cell changes.
+    if (boundary_.size() > conflict_.size() &&
+        !reserveCells(boundary_.size() - conflict_.size()))
+      return abandon();
+    for (const int c : conflict_) {
+      cells_[c].v[0] = BuildCell::FREE;
+      cells_[c].n[0] = static_cast<std::uint32_t>(free_);
+      free_ = c;
+      ++free_count_;
+      letGo(c, SharedCells::DEAD);
+    }
+    starHole();
+    if (next >= 0)
+      startTowards(point(next));
+    else
+      start_ = star_.front();
+    for (const int c : touched_)
+      letGo(c);
+    for (const int c : star_)
+      letGo(c);
+    return true;
+  }
+
+  /** Start the next walk from the cell of the latest star nearest to \a p. Only
+   * while no other builder runs, or while this one holds the star. */
+  void
+  startTowards(const Point& p)
+  {
+    // The finite cell whose corners are nearest to p on average, not any cell of
+    // it: about a point of a sampled surface the cells are thin, and a walk from
+    // the far side circles the point.
+    int start = star_.empty() ? start_ : star_.front();
     double best = std::numeric_limits<double>::infinity();
     for (const int c : star_) {
       const auto& v = cells_[c].v;
@@ -84,56 +191,43 @@ public:
         start = c;
       }
     }
-    const int first = locate(p, start);
-    // A point already there (the points should be unique) stays out: a cell of
-    // four distinct points cannot be flat.
-    for (const int v : cells_[first].v)
-      if (v != INFINITE && point(v) == p)
-        return;
-    stack_.clear();
-    conflict_.clear();
-    touched_.clear();
-    boundary_.clear();
-    prefetchNeighbors(first);
-    stack_.push_back(first);
-    conflict_.push_back(first);
-    mark_[first] = IN_CONFLICT;
-    while (!stack_.empty()) {
-      const int c = stack_.back();
-      stack_.pop_back();
-      for (int i = 0; i < 4; ++i) {
-        const std::uint32_t across = cells_[c].n[i];
-        const int other = static_cast<int>(across >> 2);
-        if (mark_[other] == IN_CONFLICT)
-          continue;
-        if (mark_[other] == UNSEEN) {
-          if (inConflict(cells_[other].v, p)) {
-            mark_[other] = IN_CONFLICT;
-            prefetchNeighbors(other);
-            stack_.push_back(other);
-            conflict_.push_back(other);
-            continue;
-          }
-          mark_[other] = OUTSIDE;
-          touched_.push_back(other);
-        }
-        boundary_.push_back({cells_[c].v, i, across});
-        boundary_.back().v[i] = q;
-      }
-    }
-    for (const int c : touched_)
-      mark_[c] = UNSEEN;
-    for (const int c : conflict_) {
-      mark_[c] = UNSEEN;
-      cells_[c].v[0] = BuildCell::FREE;
-      cells_[c].n[0] = static_cast<std::uint32_t>(free_);
-      free_ = c;
-    }
-    starHole();
+    start_ = start;
+  }
+
+  /** The cell the next walk starts from. */
+  int
+  startCell() const
+  {
+    return start_;
+  }
+
+  void
+  setStartCell(int c)
+  {
+    start_ = c;
+  }
+
+  /** Work alone from now on (\a concurrent false), or with others. */
+  void
+  setConcurrent(bool concurrent)
+  {
+    concurrent_ = concurrent;
+  }
+
+  /** Give up the cells handed out and not used: marked freed, as orderCells() skips
+   * them. */
+  void
+  finish()
+  {
+    for (; next_ < end_; ++next_)
+      cells_[next_].v[0] = BuildCell::FREE;
   }
 
 private:
-  enum Mark : std::uint8_t { UNSEEN, IN_CONFLICT, OUTSIDE };
+  /** A cell's mark, or'ed with its holder's tag. */
+  enum Mark : std::uint8_t { HELD = 1, IN_CONFLICT = 2, OUTSIDE = 3 };
+  /** Cells handed out to a builder at a time. */
+  static constexpr std::size_t BLOCK = 4096;
 
   struct BoundaryFacet {
     /** The new cell: the conflict cell's vertices with the facet's opposite one
@@ -151,8 +245,56 @@ private:
   {
     for (const std::uint32_t across : cells_[c].n) {
       __builtin_prefetch(&cells_[across >> 2]);
-      __builtin_prefetch(&mark_[across >> 2]);
+      __builtin_prefetch(&shared_.state[across >> 2]);
     }
+  }
+
+  std::uint8_t
+  stateOf(int c) const
+  {
+    return __atomic_load_n(&shared_.state[c], __ATOMIC_RELAXED);
+  }
+
+  /** Hold cell c, which no builder held before (then its contents may be read),
+   * with mark \a m. False if another builder holds it or it is dead. */
+  bool
+  take(int c, Mark m)
+  {
+    const std::uint8_t mine = tag_ | m;
+    if (!concurrent_) {
+      shared_.state[c] = mine;
+      return true;
+    }
+    std::uint8_t expected = SharedCells::FREE_TO_TAKE;
+    return __atomic_compare_exchange_n(
+        &shared_.state[c], &expected, mine, false, __ATOMIC_ACQUIRE, __ATOMIC_RELAXED);
+  }
+
+  /** Mark a cell this builder holds. */
+  void
+  mark(int c, Mark m)
+  {
+    __atomic_store_n(
+        &shared_.state[c], static_cast<std::uint8_t>(tag_ | m), __ATOMIC_RELAXED);
+  }
+
+  /** Stop holding cell c: what this builder wrote to it is seen by the next one to
+   * take it. */
+  void
+  letGo(int c, std::uint8_t state = SharedCells::FREE_TO_TAKE)
+  {
+    __atomic_store_n(&shared_.state[c], state, __ATOMIC_RELEASE);
+  }
+
+  /** Let go of every cell of an insertion that cannot go on; returns false. */
+  bool
+  abandon()
+  {
+    for (const int c : conflict_)
+      letGo(c);
+    for (const int c : touched_)
+      letGo(c);
+    return false;
   }
 
   const Point&
@@ -262,36 +404,83 @@ private:
     return coplanarSideOfBoundedCircle(a, b, c, p) > 0;
   }
 
-  /** Walk towards p: first with plain floating-point orientations, cheap and
-   * possibly wrong near p (it only chooses where to start), then with exact ones,
-   * each step through a facet that p lies beyond, tried from a random facet (a
-   * walk that cannot cycle). Ends in a cell containing p, or in an infinite cell
-   * in conflict with p when p lies outside the hull. */
+  /** Walk towards p from the start cell: first with plain floating-point
+   * orientations, cheap and possibly wrong near p (it only chooses where to start),
+   * then with exact ones, each step through a facet that p lies beyond, tried from a
+   * random facet (a walk that cannot cycle). Ends in a cell containing p, or in an
+   * infinite cell in conflict with p when p lies outside the hull: held. A walk
+   * holds one cell at a time, taking the next before it lets go of the last; -1
+   * (nothing held) where another builder holds a cell on the way. */
   int
-  locate(const Point& p, int c)
+  locate(const Point& p)
   {
-    c = roughWalk(p, c);
+    if (!takeStart())
+      return -1;
+    int c = roughWalk(p, start_);
+    if (c < 0)
+      return -1;
     const Kernel::Orientation_3 orientation;
     int previous = -1;
     for (;;) {
       const BuildCell& cell = cells_[c];
       const int i3 = infiniteCorner(cell.v);
+      int next;
       if (i3 >= 0) {
         if (inConflict(cell.v, p))
           return c;
         // p is not beyond this hull facet: back inside.
-        previous = c;
-        c = static_cast<int>(cell.n[i3] >> 2);
-        continue;
+        next = static_cast<int>(cell.n[i3] >> 2);
       }
-      const int next = step(cell, p, previous, [&](const auto& q) {
-        return orientation(*q[0], *q[1], *q[2], *q[3]) == CGAL::NEGATIVE;
-      });
-      if (next < 0)
-        return c;
+      else {
+        next = step(cell, p, previous, [&](const auto& q) {
+          return orientation(*q[0], *q[1], *q[2], *q[3]) == CGAL::NEGATIVE;
+        });
+        if (next < 0)
+          return c;
+      }
+      if (!moveTo(c, next))
+        return -1;
       previous = c;
       c = next;
     }
+  }
+
+  /** Take the start cell; if another builder holds it or freed it, a cell of the
+   * latest star, or the latest cell handed out to this builder that is free. */
+  bool
+  takeStart()
+  {
+    const auto taken = [&](std::size_t c) {
+      if (stateOf(static_cast<int>(c)) != SharedCells::FREE_TO_TAKE ||
+          !take(static_cast<int>(c), HELD))
+        return false;
+      start_ = static_cast<int>(c);
+      return true;
+    };
+    if (taken(start_))
+      return true;
+    for (const int c : star_)
+      if (taken(c))
+        return true;
+    // Alone, any live cell will do; with others, one of this builder's latest.
+    const std::size_t used = std::min(shared_.used.load(), cells_.size());
+    const std::size_t from = concurrent_ ? next_ : used;
+    for (std::size_t c = from; c-- > 0 && (!concurrent_ || from - c <= BLOCK);)
+      if (taken(c))
+        return true;
+    return false;
+  }
+
+  /** One step of a walk: take cell \a next, let go of \a c. */
+  bool
+  moveTo(int c, int next)
+  {
+    if (!take(next, HELD)) {
+      letGo(c);
+      return false;
+    }
+    letGo(c);
+    return true;
   }
 
   /** One step of a walk from finite cell \a cell: the cell across the first facet,
@@ -343,6 +532,8 @@ private:
       });
       if (next < 0)
         return c;
+      if (!moveTo(c, next))
+        return -1;
       previous = c;
       c = next;
     }
@@ -356,20 +547,62 @@ private:
     return static_cast<int>(random_ >> 30);
   }
 
+  /** Make sure \a count cells can be allocated, from the freed ones and this
+   * builder's block of cells handed out; false if no block is left (then nothing
+   * changed). Alone, a builder grows the cells instead. */
+  bool
+  reserveCells(std::size_t count)
+  {
+    while (free_count_ + (end_ - next_) < count) {
+      const std::size_t size = std::max(BLOCK, count);
+      std::size_t first = shared_.used.load(std::memory_order_relaxed);
+      do {
+        // Codes are cell * 4 + facet in 32 bits.
+        if (first + size > (std::size_t(1) << 30)) {
+          if (concurrent_)
+            return false;
+          throw std::bad_alloc();
+        }
+        if (first + size > cells_.size()) {
+          if (concurrent_)
+            return false;
+          const std::size_t grown = std::max(first + size, cells_.size() * 3 / 2);
+          cells_.resize(grown);
+          shared_.state.resize(grown, SharedCells::DEAD);
+        }
+      }
+      while (!shared_.used.compare_exchange_weak(
+          first, first + size, std::memory_order_relaxed));
+      // A block right after the last one extends it; else the last one's rest is
+      // freed.
+      if (first != end_) {
+        for (; next_ < end_; ++next_) {
+          cells_[next_].v[0] = BuildCell::FREE;
+          cells_[next_].n[0] = static_cast<std::uint32_t>(free_);
+          free_ = static_cast<int>(next_);
+          ++free_count_;
+        }
+        next_ = first;
+      }
+      end_ = first + size;
+    }
+    return true;
+  }
+
+  /** A new cell, held; reserveCells() made room for it. */
   int
   allocate()
   {
+    int c;
     if (free_ >= 0) {
-      const int c = free_;
+      c = free_;
       free_ = static_cast<int>(cells_[c].n[0]);
-      return c;
+      --free_count_;
     }
-    // Codes are cell * 4 + facet in 32 bits.
-    if (cells_.size() >= (std::size_t(1) << 30))
-      throw std::bad_alloc();
-    cells_.emplace_back();
-    mark_.push_back(UNSEEN);
-    return static_cast<int>(cells_.size()) - 1;
+    else
+      c = static_cast<int>(next_++);
+    mark(c, HELD);
+    return c;
   }
 
   /** Fill the hole with one new cell per boundary facet; new cells meet along the
@@ -430,8 +663,11 @@ private:
   };
 
   const std::vector<Point>& points_;
-  std::vector<BuildCell>& cells_;
-  std::vector<std::uint8_t> mark_;
+  SharedCells& shared_;
+  BuildCells& cells_;
+  /** This builder's tag in the cells' states. */
+  const std::uint8_t tag_;
+  bool concurrent_;
   std::vector<int> stack_, conflict_, touched_;
   /** The cells made by the latest insertion. */
   std::vector<int> star_;
@@ -439,13 +675,19 @@ private:
   std::vector<Edge> edges_;
   std::uint32_t stamp_ = 0;
   std::uint32_t random_ = 12345;
+  /** Where the next walk starts. */
+  int start_ = 0;
+  /** This builder's freed cells, linked through n[0]. */
   int free_ = -1;
+  std::size_t free_count_ = 0;
+  /** The cells of this builder's block not used yet. */
+  std::size_t next_ = 0, end_ = 0;
 };
 
 } // namespace
 
 int
-buildDelaunay(const std::vector<Eigen::Vector3d>& input, std::vector<BuildCell>& cells)
+buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int threads)
 {
   cells.clear();
   const int n = static_cast<int>(input.size());
@@ -489,14 +731,96 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, std::vector<BuildCell>&
   if (fourth < 0)
     return 2;
 
-  // About 7 cells per point in a volume, up to 15 on a sampled surface; reserved
-  // address space costs no memory until it is used.
-  cells.reserve(std::size_t(n) * 16);
-  Builder builder(points, cells);
-  builder.start({order[0], order[1], order[third], order[fourth]});
+  // The points left to insert, and how many of them come before CGAL's last round
+  // (in 3D its multiscale sort puts the first twentieth of the points, from 500 on,
+  // in earlier rounds): the last round follows one Hilbert curve, cut below into a
+  // stretch per thread.
+  std::vector<int> rest;
+  rest.reserve(input.size());
+  const int last_round = n > 500 ? static_cast<int>(double(n) * 0.05) : 0;
+  std::size_t before_last_round = 0;
   for (int k = 2; k < n; ++k)
-    if (k != third && k != fourth)
-      builder.insert(order[k]);
+    if (k != third && k != fourth) {
+      rest.push_back(order[k]);
+      before_last_round += k < last_round;
+    }
+  const std::array<int, 4> tetrahedron{order[0], order[1], order[third], order[fourth]};
+  std::vector<int>().swap(order);
+
+  // About 7 cells per point in a volume, up to 15 on a sampled surface: sized
+  // ahead, the cells cost no memory until they are used.
+  cells.resize(std::size_t(n) * 16 + 64);
+  SharedCells shared(cells);
+  shared.state.assign(cells.size(), SharedCells::DEAD);
+  Builder main(points, shared, 0, false);
+  main.start(tetrahedron);
+  const std::size_t m = rest.size();
+  const auto next = [&](std::size_t k, std::size_t end) {
+    return k + 1 < end ? rest[k + 1] : -1;
+  };
+  // Threads pay once each stretch holds some ten thousand points.
+  const std::size_t last = m - before_last_round;
+  const int team = std::max(1, std::min(threads, static_cast<int>(last / 10000)));
+  const std::size_t alone = team > 1 ? before_last_round : m;
+  for (std::size_t k = 0; k < alone; ++k)
+    main.insert(rest[k], next(k, m));
+  if (team > 1) {
+    std::vector<std::size_t> bound(team + 1);
+    for (int t = 0; t <= team; ++t)
+      bound[t] = before_last_round + last * t / team;
+    // Each builder starts next to its stretch's first point, from the latest star.
+    std::vector<std::unique_ptr<Builder>> builders;
+    for (int t = team - 1; t >= 0; --t) {
+      main.startTowards(points[rest[bound[t]]]);
+      if (t > 0) {
+        builders.push_back(std::make_unique<Builder>(points, shared, t, true));
+        builders.back()->setStartCell(main.startCell());
+      }
+    }
+    std::reverse(builders.begin(), builders.end());
+    main.setConcurrent(true);
+    std::vector<std::vector<std::size_t>> left(team);
+    std::atomic<bool> failed{false};
+    const auto work = [&](int t) {
+      Builder& builder = t == 0 ? main : *builders[t - 1];
+      try {
+        for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
+          if (!builder.insert(rest[k], next(k, bound[t + 1])))
+            left[t].push_back(k);
+      }
+      catch (const std::bad_alloc&) {
+        failed = true;
+      }
+      if (t > 0)
+        builder.finish();
+    };
+    // A stretch whose thread could not be started is inserted after the others.
+    std::vector<std::thread> workers;
+    int started = 1;
+    try {
+      for (; started < team; ++started)
+        workers.emplace_back(work, started);
+    }
+    catch (const std::system_error&) {
+    }
+    work(0);
+    for (auto& worker : workers)
+      worker.join();
+    if (failed)
+      throw std::bad_alloc();
+    for (int t = started; t < team; ++t)
+      for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
+        left[t].push_back(k);
+    // What met another thread, in the order of the curve.
+    main.setConcurrent(false);
+    std::vector<std::size_t> after;
+    for (const auto& l : left)
+      after.insert(after.end(), l.begin(), l.end());
+    for (std::size_t j = 0; j < after.size(); ++j)
+      main.insert(rest[after[j]], j + 1 < after.size() ? rest[after[j + 1]] : -1);
+  }
+  main.finish();
+  cells.resize(std::min(shared.used.load(), cells.size()));
   return 3;
 }
 

@@ -13,6 +13,9 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace pcl {
@@ -33,6 +36,35 @@ struct BuildCell {
   std::array<std::uint32_t, 4> n;
 };
 
+/** An allocator that default-initializes: a vector of trivial cells sized ahead of
+ * use costs no memory until its cells are written. */
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <typename U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept
+  {}
+  template <typename U>
+  void
+  construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value)
+  {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void
+  construct(U* p, Args&&... args)
+  {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+/** The cells as built, freed ones included (v[0] == BuildCell::FREE). */
+using BuildCells = std::vector<BuildCell, DefaultInitAllocator<BuildCell>>;
+
 /** The index of the vertex at infinity in a cell's vertices, -1 for a finite cell. */
 inline int
 infiniteCorner(const std::array<int, 4>& v)
@@ -51,13 +83,22 @@ infiniteCorner(const std::array<int, 4>& v)
  * CGAL's Delaunay_triangulation_3: the Delaunay triangulation is unique under the
  * perturbation. Kept in two 16-byte arrays per cell instead of CGAL's linked cells,
  * which halves its memory and lets the passes read cells by index.
+ *
+ * With several threads, the points after the first twentieth (CGAL's last round,
+ * along one Hilbert curve) are cut into one stretch of the curve per thread, a part
+ * of space each, and inserted at once; a thread holds every cell it reads, and an
+ * insertion that meets a cell held by another thread is left for the end, when one
+ * thread inserts what is left. The triangulation is unique, so the cells are the
+ * same whatever the thread count (their order in \a cells is not).
  * \param[in] points unique points
  * \param[out] cells the cells, finite and infinite, and freed ones (v[0] == FREE)
+ * \param[in] threads threads to insert with
  * \return the affine dimension of the points: below 3 the cells are left empty
  */
 int
 buildDelaunay(const std::vector<Eigen::Vector3d>& points,
-              std::vector<BuildCell>& cells);
+              BuildCells& cells,
+              int threads = 1);
 
 /** The triangulation as the passes read it: the finite cells in the order they
  * are visited, then the infinite ones (dimension 3: one per hull facet). */
@@ -74,7 +115,7 @@ struct DelaunayStructure {
   Eigen::Vector3d* circumcenters = nullptr;
   /** The cells as built, emptied: their pages are resident, and fresh pages would
    * cost more in page faults (0.7 ms a MB here) than computing the circumcenters. */
-  std::vector<BuildCell> build;
+  BuildCells build;
 };
 
 } // namespace detail

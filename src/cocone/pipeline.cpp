@@ -153,7 +153,8 @@ runStages(std::vector<Eigen::Vector3d>&& points,
     return result;
   }
 
-  Triangulation dt = triangulate(std::move(unique.points));
+  Triangulation dt =
+      triangulate(std::move(unique.points), resolveThreads(parameters.threads));
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";

@@ -178,7 +178,7 @@ circumcenterCells(std::size_t finite)
 /** Hand the pages of \a cells past the first \a keep cells back to the system (their
  * contents are not needed any more); the address space stays. */
 void
-releaseTail(std::vector<detail::BuildCell>& cells, std::size_t keep)
+releaseTail(detail::BuildCells& cells, std::size_t keep)
 {
 #ifdef __linux__
   // Whole pages only, in bytes from the start of the array.
@@ -207,8 +207,7 @@ using PlanarDelaunay = CGAL::Delaunay_triangulation_3<
 
 /** The planar triangulation of coplanar points, as cells of three corners. */
 void
-triangulatePlanar(const std::vector<Eigen::Vector3d>& points,
-                  std::vector<detail::BuildCell>& cells)
+triangulatePlanar(const std::vector<Eigen::Vector3d>& points, detail::BuildCells& cells)
 {
   std::vector<std::pair<Kernel::Point_3, int>> sites;
   sites.reserve(points.size());
@@ -238,7 +237,7 @@ triangulatePlanar(const std::vector<Eigen::Vector3d>& points,
  * this order the cells across a cell's facets and the per-vertex records of its
  * vertices are mostly in cache when a pass needs them. */
 void
-orderCells(const std::vector<detail::BuildCell>& built,
+orderCells(const detail::BuildCells& built,
            int corners,
            std::size_t number_of_vertices,
            detail::DelaunayStructure& out)
@@ -338,7 +337,7 @@ computeCircumcenters(const Triangulation& dt, int threads)
 } // namespace
 
 Triangulation
-triangulate(std::vector<Eigen::Vector3d> points)
+triangulate(std::vector<Eigen::Vector3d> points, int threads)
 {
   Triangulation out;
   if (points.empty())
@@ -353,8 +352,8 @@ triangulate(std::vector<Eigen::Vector3d> points)
     p -= out.offset;
   out.points = std::move(points);
 
-  std::vector<detail::BuildCell> cells;
-  out.dimension = detail::buildDelaunay(out.points, cells);
+  detail::BuildCells cells;
+  out.dimension = detail::buildDelaunay(out.points, cells, threads);
   if (out.dimension == 2) {
     // CGAL's insertion keeps scratch tables in thread-local storage that an
     // exception (std::bad_alloc) leaves dirty, which breaks every later insertion in
