@@ -684,6 +684,82 @@ private:
   std::size_t next_ = 0, end_ = 0;
 };
 
+/** Insert rest[lo, hi), one round of the spatial sort, with up to \a threads
+ * builders (\a main is the first), a stretch of the round each. */
+void
+insertRound(const std::vector<Point>& points,
+            const std::vector<int>& rest,
+            std::size_t lo,
+            std::size_t hi,
+            int threads,
+            SharedCells& shared,
+            Builder& main)
+{
+  const auto next = [&](std::size_t k, std::size_t end) {
+    return k + 1 < end ? rest[k + 1] : -1;
+  };
+  // Threads pay once each stretch holds some ten thousand points.
+  const int team = std::max(1, std::min(threads, static_cast<int>((hi - lo) / 10000)));
+  if (team == 1) {
+    for (std::size_t k = lo; k < hi; ++k)
+      main.insert(rest[k], next(k, hi));
+    return;
+  }
+  std::vector<std::size_t> bound(team + 1);
+  for (int t = 0; t <= team; ++t)
+    bound[t] = lo + (hi - lo) * t / team;
+  // Each builder starts next to its stretch's first point, from the latest star.
+  std::vector<std::unique_ptr<Builder>> builders;
+  for (int t = team - 1; t >= 0; --t) {
+    main.startTowards(points[rest[bound[t]]]);
+    if (t > 0) {
+      builders.push_back(std::make_unique<Builder>(points, shared, t, true));
+      builders.back()->setStartCell(main.startCell());
+    }
+  }
+  std::reverse(builders.begin(), builders.end());
+  main.setConcurrent(true);
+  std::vector<std::vector<std::size_t>> left(team);
+  std::atomic<bool> failed{false};
+  const auto work = [&](int t) {
+    Builder& builder = t == 0 ? main : *builders[t - 1];
+    try {
+      for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
+        if (!builder.insert(rest[k], next(k, bound[t + 1])))
+          left[t].push_back(k);
+    }
+    catch (const std::bad_alloc&) {
+      failed = true;
+    }
+    if (t > 0)
+      builder.finish();
+  };
+  // A stretch whose thread could not be started is inserted after the others.
+  std::vector<std::thread> workers;
+  int started = 1;
+  try {
+    for (; started < team; ++started)
+      workers.emplace_back(work, started);
+  }
+  catch (const std::system_error&) {
+  }
+  work(0);
+  for (auto& worker : workers)
+    worker.join();
+  if (failed)
+    throw std::bad_alloc();
+  for (int t = started; t < team; ++t)
+    for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
+      left[t].push_back(k);
+  // What met another thread, in the order of the curve.
+  main.setConcurrent(false);
+  std::vector<std::size_t> after;
+  for (const auto& l : left)
+    after.insert(after.end(), l.begin(), l.end());
+  for (std::size_t j = 0; j < after.size(); ++j)
+    main.insert(rest[after[j]], j + 1 < after.size() ? rest[after[j + 1]] : -1);
+}
+
 } // namespace
 
 int
@@ -731,19 +807,24 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   if (fourth < 0)
     return 2;
 
-  // The points left to insert, and how many of them come before CGAL's last round
-  // (in 3D its multiscale sort puts the first twentieth of the points, from 500 on,
-  // in earlier rounds): the last round follows one Hilbert curve, cut below into a
-  // stretch per thread.
+  // The points left to insert, and where CGAL's rounds begin among them: in 3D its
+  // multiscale sort sorts the first twentieth of the points (from 500 on) the same
+  // way before it, and the rest along one Hilbert curve; a round long enough is cut
+  // below into a stretch of its curve per thread.
+  std::vector<int> round_end{n};
+  while (round_end.back() > 500)
+    round_end.push_back(static_cast<int>(double(round_end.back()) * 0.05));
+  std::reverse(round_end.begin(), round_end.end());
   std::vector<int> rest;
   rest.reserve(input.size());
-  const int last_round = n > 500 ? static_cast<int>(double(n) * 0.05) : 0;
-  std::size_t before_last_round = 0;
-  for (int k = 2; k < n; ++k)
-    if (k != third && k != fourth) {
+  std::vector<std::size_t> rounds{0}; // in rest
+  for (int k = 2, r = 0; k < n; ++k) {
+    for (; k >= round_end[r]; ++r)
+      rounds.push_back(rest.size());
+    if (k != third && k != fourth)
       rest.push_back(order[k]);
-      before_last_round += k < last_round;
-    }
+  }
+  rounds.push_back(rest.size());
   const std::array<int, 4> tetrahedron{order[0], order[1], order[third], order[fourth]};
   std::vector<int>().swap(order);
 
@@ -754,71 +835,8 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   shared.state.assign(cells.size(), SharedCells::DEAD);
   Builder main(points, shared, 0, false);
   main.start(tetrahedron);
-  const std::size_t m = rest.size();
-  const auto next = [&](std::size_t k, std::size_t end) {
-    return k + 1 < end ? rest[k + 1] : -1;
-  };
-  // Threads pay once each stretch holds some ten thousand points.
-  const std::size_t last = m - before_last_round;
-  const int team = std::max(1, std::min(threads, static_cast<int>(last / 10000)));
-  const std::size_t alone = team > 1 ? before_last_round : m;
-  for (std::size_t k = 0; k < alone; ++k)
-    main.insert(rest[k], next(k, m));
-  if (team > 1) {
-    std::vector<std::size_t> bound(team + 1);
-    for (int t = 0; t <= team; ++t)
-      bound[t] = before_last_round + last * t / team;
-    // Each builder starts next to its stretch's first point, from the latest star.
-    std::vector<std::unique_ptr<Builder>> builders;
-    for (int t = team - 1; t >= 0; --t) {
-      main.startTowards(points[rest[bound[t]]]);
-      if (t > 0) {
-        builders.push_back(std::make_unique<Builder>(points, shared, t, true));
-        builders.back()->setStartCell(main.startCell());
-      }
-    }
-    std::reverse(builders.begin(), builders.end());
-    main.setConcurrent(true);
-    std::vector<std::vector<std::size_t>> left(team);
-    std::atomic<bool> failed{false};
-    const auto work = [&](int t) {
-      Builder& builder = t == 0 ? main : *builders[t - 1];
-      try {
-        for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
-          if (!builder.insert(rest[k], next(k, bound[t + 1])))
-            left[t].push_back(k);
-      }
-      catch (const std::bad_alloc&) {
-        failed = true;
-      }
-      if (t > 0)
-        builder.finish();
-    };
-    // A stretch whose thread could not be started is inserted after the others.
-    std::vector<std::thread> workers;
-    int started = 1;
-    try {
-      for (; started < team; ++started)
-        workers.emplace_back(work, started);
-    }
-    catch (const std::system_error&) {
-    }
-    work(0);
-    for (auto& worker : workers)
-      worker.join();
-    if (failed)
-      throw std::bad_alloc();
-    for (int t = started; t < team; ++t)
-      for (std::size_t k = bound[t]; k < bound[t + 1]; ++k)
-        left[t].push_back(k);
-    // What met another thread, in the order of the curve.
-    main.setConcurrent(false);
-    std::vector<std::size_t> after;
-    for (const auto& l : left)
-      after.insert(after.end(), l.begin(), l.end());
-    for (std::size_t j = 0; j < after.size(); ++j)
-      main.insert(rest[after[j]], j + 1 < after.size() ? rest[after[j + 1]] : -1);
-  }
+  for (std::size_t r = 0; r + 1 < rounds.size(); ++r)
+    insertRound(points, rest, rounds[r], rounds[r + 1], threads, shared, main);
   main.finish();
   cells.resize(std::min(shared.used.load(), cells.size()));
   return 3;

@@ -105,9 +105,9 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& points,
 struct DelaunayStructure {
   /** Vertex ids per cell (INFINITE for the vertex at infinity; dimension 2: the
    * three corners, then -1). */
-  std::vector<std::array<int, 4>> vertices;
+  std::vector<std::array<int, 4>, DefaultInitAllocator<std::array<int, 4>>> vertices;
   /** Per cell, the cell across the facet opposite vertices[c][i]. */
-  std::vector<std::array<int, 4>> neighbors;
+  std::vector<std::array<int, 4>, DefaultInitAllocator<std::array<int, 4>>> neighbors;
   /** Cells [0, finite) are finite. */
   std::size_t finite = 0;
   /** Per finite cell its circumcenter once a pass has asked for them, null before:

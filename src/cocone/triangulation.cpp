@@ -231,58 +231,6 @@ triangulatePlanar(const std::vector<Eigen::Vector3d>& points, detail::BuildCells
   }
 }
 
-/** Keep the cells in the order the passes visit them: the finite cells by smallest
- * vertex id, in buckets of 64 ids (a counting sort with few write positions; inside
- * a bucket the builder's order, which does not matter), then the infinite ones. In
- * this order the cells across a cell's facets and the per-vertex records of its
- * vertices are mostly in cache when a pass needs them. */
-void
-orderCells(const detail::BuildCells& built,
-           int corners,
-           std::size_t number_of_vertices,
-           detail::DelaunayStructure& out)
-{
-  constexpr int BUCKET_BITS = 6;
-  constexpr int FREE = -1;
-  const int infinite = static_cast<int>(number_of_vertices >> BUCKET_BITS) + 1;
-  std::vector<std::uint32_t> start(infinite + 2, 0);
-  // Per built cell its bucket, then its place.
-  std::vector<int> slot(built.size(), FREE);
-  for (std::size_t c = 0; c < built.size(); ++c) {
-    const auto& v = built[c].v;
-    if (v[0] == detail::BuildCell::FREE)
-      continue;
-    int lowest = v[0];
-    for (int i = 1; i < corners; ++i)
-      lowest = (lowest < 0 || v[i] < 0) ? -1 : std::min(lowest, v[i]);
-    slot[c] = lowest < 0 ? infinite : lowest >> BUCKET_BITS;
-    ++start[slot[c] + 1];
-  }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  out.finite = start[infinite];
-  for (int& s : slot)
-    if (s != FREE)
-      s = static_cast<int>(start[s]++);
-  out.vertices.resize(start.back());
-  out.neighbors.resize(start.back());
-  for (std::size_t c = 0; c < built.size(); ++c) {
-    if (slot[c] == FREE)
-      continue;
-    auto& v = out.vertices[slot[c]];
-    auto& n = out.neighbors[slot[c]];
-    v = built[c].v;
-    for (int i = 0; i < 4; ++i)
-      n[i] = i < corners ? slot[built[c].n[i] >> 2] : -1;
-  }
-}
-
-/** Number of the cells' corners: 4, or 3 when the triangulation is planar. */
-int
-cornersOf(const Triangulation& dt)
-{
-  return dt.dimension == 3 ? 4 : 3;
-}
-
 /** Run body(first, end, thread) over the finite cells, split in equal runs per
  * thread. */
 template <typename Body>
@@ -308,6 +256,78 @@ splitCells(std::size_t count, int threads, const Body& body)
   }
   if (failed)
     throw std::bad_alloc();
+}
+
+/** Keep the cells in the order the passes visit them: the finite cells by smallest
+ * vertex id, in buckets of 64 ids (a counting sort with few write positions; inside
+ * a bucket the builder's order, which does not matter), then the infinite ones. In
+ * this order the cells across a cell's facets and the per-vertex records of its
+ * vertices are mostly in cache when a pass needs them. */
+void
+orderCells(const detail::BuildCells& built,
+           int corners,
+           std::size_t number_of_vertices,
+           int threads,
+           detail::DelaunayStructure& out)
+{
+  constexpr int BUCKET_BITS = 6;
+  constexpr int FREE = -1;
+  const int infinite = static_cast<int>(number_of_vertices >> BUCKET_BITS) + 1;
+  // A counting sort by bucket, each thread counting a range of the built cells: the
+  // places follow bucket by bucket, then thread by thread, the builder's order.
+  std::vector<std::vector<std::uint32_t>> start(threads);
+  // Per built cell its bucket, then its place.
+  std::vector<int> slot(built.size());
+  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
+    start[t].assign(infinite + 1, 0);
+    for (std::size_t c = begin; c < end; ++c) {
+      const auto& v = built[c].v;
+      slot[c] = FREE;
+      if (v[0] == detail::BuildCell::FREE)
+        continue;
+      int lowest = v[0];
+      for (int i = 1; i < corners; ++i)
+        lowest = (lowest < 0 || v[i] < 0) ? -1 : std::min(lowest, v[i]);
+      slot[c] = lowest < 0 ? infinite : lowest >> BUCKET_BITS;
+      ++start[t][slot[c]];
+    }
+  });
+  std::uint32_t total = 0;
+  for (int b = 0; b <= infinite; ++b) {
+    if (b == infinite)
+      out.finite = total;
+    for (auto& count : start) {
+      const std::uint32_t here = count[b];
+      count[b] = total;
+      total += here;
+    }
+  }
+  // Sized without being written: the pages are first touched by the threads below.
+  out.vertices.resize(total);
+  out.neighbors.resize(total);
+  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
+    for (std::size_t c = begin; c < end; ++c)
+      if (slot[c] != FREE)
+        slot[c] = static_cast<int>(start[t][slot[c]]++);
+  });
+  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t c = begin; c < end; ++c) {
+      if (slot[c] == FREE)
+        continue;
+      auto& v = out.vertices[slot[c]];
+      auto& n = out.neighbors[slot[c]];
+      v = built[c].v;
+      for (int i = 0; i < 4; ++i)
+        n[i] = i < corners ? slot[built[c].n[i] >> 2] : -1;
+    }
+  });
+}
+
+/** Number of the cells' corners: 4, or 3 when the triangulation is planar. */
+int
+cornersOf(const Triangulation& dt)
+{
+  return dt.dimension == 3 ? 4 : 3;
 }
 
 /** The circumcenters of the finite cells, from their vertices in ascending id
@@ -376,7 +396,7 @@ triangulate(std::vector<Eigen::Vector3d> points, int threads)
     return out;
 
   out.structure = std::make_shared<detail::DelaunayStructure>();
-  orderCells(cells, cornersOf(out), out.points.size(), *out.structure);
+  orderCells(cells, cornersOf(out), out.points.size(), threads, *out.structure);
   // The built cells' memory waits for the circumcenters; what they will not need
   // goes back to the system before the passes add their arrays on top.
   out.structure->build = std::move(cells);
