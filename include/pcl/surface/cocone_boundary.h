@@ -192,8 +192,9 @@ public:
 
   /** \brief Set the number of threads (PCL convention: 0 = all processors).
    *
-   * The output does not depend on it. The passes over the Voronoi cells and the
-   * half-disk test run in parallel; the other stages on one thread.
+   * The output does not depend on it. The Delaunay triangulation (from about ten
+   * thousand points a thread), the passes over the Voronoi cells, the half-disk test
+   * and most of the reconstruction run in parallel; the walk on one thread.
    * \param[in] nr_threads number of threads, 0 for all (default 1)
    */
   void
