@@ -50,7 +50,11 @@ struct SharedCells {
  * a cone of new cells from its boundary facets to the point. */
 class Builder {
 public:
-  /** \param[in] id this builder's number, below 63
+  /** Builders that can tell their cells apart: a state holds (id + 1) << 2 | mark
+   * below SharedCells::DEAD. */
+  static constexpr int MAX_BUILDERS = 62;
+
+  /** \param[in] id this builder's number, below MAX_BUILDERS
    *  \param[in] concurrent whether other builders insert at the same time */
   Builder(const std::vector<Point>& points,
           SharedCells& shared,
@@ -226,6 +230,8 @@ public:
 private:
   /** A cell's mark, or'ed with its holder's tag. */
   enum Mark : std::uint8_t { HELD = 1, IN_CONFLICT = 2, OUTSIDE = 3 };
+  static_assert((MAX_BUILDERS << 2 | OUTSIDE) < SharedCells::DEAD,
+                "every builder's marks fit below DEAD");
   /** Cells handed out to a builder at a time. */
   static constexpr std::size_t BLOCK = 4096;
 
@@ -462,10 +468,13 @@ private:
     for (const int c : star_)
       if (taken(c))
         return true;
-    // Alone, any live cell will do; with others, one of this builder's latest.
+    // Alone, any live cell will do; with others, one of this builder's latest, or
+    // before it has any (its first start was taken by another builder, which may
+    // have freed it), one of the latest handed out.
     const std::size_t used = std::min(shared_.used.load(), cells_.size());
-    const std::size_t from = concurrent_ ? next_ : used;
-    for (std::size_t c = from; c-- > 0 && (!concurrent_ || from - c <= BLOCK);)
+    const std::size_t from = concurrent_ && next_ > 0 ? next_ : used;
+    const std::size_t reach = concurrent_ ? 16 * BLOCK : used;
+    for (std::size_t c = from; c-- > 0 && from - c <= reach;)
       if (taken(c))
         return true;
     return false;
@@ -698,8 +707,11 @@ insertRound(const std::vector<Point>& points,
   const auto next = [&](std::size_t k, std::size_t end) {
     return k + 1 < end ? rest[k + 1] : -1;
   };
-  // Threads pay once each stretch holds some ten thousand points.
-  const int team = std::max(1, std::min(threads, static_cast<int>((hi - lo) / 10000)));
+  // Threads pay once each stretch holds some ten thousand points; a state byte
+  // tells up to 62 builders apart.
+  const int team = std::max(
+      1,
+      std::min({threads, Builder::MAX_BUILDERS, static_cast<int>((hi - lo) / 10000)}));
   if (team == 1) {
     for (std::size_t k = lo; k < hi; ++k)
       main.insert(rest[k], next(k, hi));
