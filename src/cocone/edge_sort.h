@@ -89,6 +89,30 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
   return word;
 }
 
+/** Sort \a items by the vertex ids key(item) (lexicographically; the first id below
+ * \a n): a counting sort on the first id, then each bucket, a handful of items, on
+ * its own. The order of std::sort by the keys where they differ, in linear time. */
+template <typename T, typename Key>
+void
+sortByVertexIds(std::vector<T>& items, std::size_t n, const Key& key)
+{
+  std::vector<std::uint32_t> start(n + 1, 0);
+  for (const T& x : items)
+    ++start[key(x)[0] + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<T> sorted(items.size());
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (const T& x : items)
+      sorted[fill[key(x)[0]]++] = x;
+  }
+  for (std::size_t v = 0; v < n; ++v)
+    std::sort(sorted.begin() + start[v],
+              sorted.begin() + start[v + 1],
+              [&](const T& a, const T& b) { return key(a) < key(b); });
+  items.swap(sorted);
+}
+
 } // namespace detail
 } // namespace cocone
 } // namespace pcl

@@ -17,6 +17,8 @@
 
 #include <Eigen/Geometry>
 
+#include "edge_sort.h"
+
 #include <algorithm>
 #include <chrono>
 #include <limits>
@@ -105,7 +107,8 @@ reconstruct(Triangulation& dt,
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
-  std::sort(result.triangles.begin(), result.triangles.end());
+  detail::sortByVertexIds(
+      result.triangles, dt.points.size(), [](const Triangle& t) { return t; });
 
   // Normals: the pole line, turned to the side the mesh faces. At an undersampled
   // point the pole says little (at a border it leans towards the convex hull): there
