@@ -154,13 +154,8 @@ public:
     if (boundary_.size() > conflict_.size() &&
         !reserveCells(boundary_.size() - conflict_.size()))
       return abandon();
-    for (const int c : conflict_) {
-      cells_[c].v[0] = BuildCell::FREE;
-      cells_[c].n[0] = static_cast<std::uint32_t>(free_);
-      free_ = c;
-      ++free_count_;
-      letGo(c, SharedCells::DEAD);
-    }
+    for (const int c : conflict_)
+      freeCell(c);
     starHole();
     if (next >= 0)
       startTowards(point(next));
@@ -585,17 +580,24 @@ private:
       // A block right after the last one extends it; else the last one's rest is
       // freed.
       if (first != end_) {
-        for (; next_ < end_; ++next_) {
-          cells_[next_].v[0] = BuildCell::FREE;
-          cells_[next_].n[0] = static_cast<std::uint32_t>(free_);
-          free_ = static_cast<int>(next_);
-          ++free_count_;
-        }
+        for (; next_ < end_; ++next_)
+          freeCell(static_cast<int>(next_));
         next_ = first;
       }
       end_ = first + size;
     }
     return true;
+  }
+
+  /** Put cell c on this builder's free list (dead to the others). */
+  void
+  freeCell(int c)
+  {
+    cells_[c].v[0] = BuildCell::FREE;
+    cells_[c].n[0] = static_cast<std::uint32_t>(free_);
+    free_ = c;
+    ++free_count_;
+    letGo(c, SharedCells::DEAD);
   }
 
   /** A new cell, held; reserveCells() made room for it. */
@@ -720,16 +722,15 @@ insertRound(const std::vector<Point>& points,
   std::vector<std::size_t> bound(team + 1);
   for (int t = 0; t <= team; ++t)
     bound[t] = lo + (hi - lo) * t / team;
-  // Each builder starts next to its stretch's first point, from the latest star.
+  // Each builder starts next to its stretch's first point, from the latest star
+  // (main's own start chosen last).
   std::vector<std::unique_ptr<Builder>> builders;
-  for (int t = team - 1; t >= 0; --t) {
+  for (int t = 1; t < team; ++t) {
     main.startTowards(points[rest[bound[t]]]);
-    if (t > 0) {
-      builders.push_back(std::make_unique<Builder>(points, shared, t, true));
-      builders.back()->setStartCell(main.startCell());
-    }
+    builders.push_back(std::make_unique<Builder>(points, shared, t, true));
+    builders.back()->setStartCell(main.startCell());
   }
-  std::reverse(builders.begin(), builders.end());
+  main.startTowards(points[rest[bound[0]]]);
   main.setConcurrent(true);
   std::vector<std::vector<std::size_t>> left(team);
   std::atomic<bool> failed{false};

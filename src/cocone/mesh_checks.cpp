@@ -67,46 +67,35 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
 void
 EdgeIncidences::add(const std::vector<Triangle>& oriented, std::size_t from)
 {
-  struct Incidence {
-    std::array<int, 2> edge;
-    int triangle;
-    bool forward;
-  };
-  std::vector<Incidence> added;
-  for (std::size_t t = from; t < oriented.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const int a = oriented[t][k], b = oriented[t][(k + 1) % 3];
-      added.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(t), a < b});
-    }
-  std::sort(added.begin(), added.end(), [](const Incidence& x, const Incidence& y) {
-    return x.edge < y.edge || (x.edge == y.edge && x.triangle < y.triangle);
-  });
-  // One merge of two lists sorted by edge; at an edge the new triangles come last,
-  // as their ids are the highest.
+  // The new triangles grouped on their own, then one merge of the two groupings
+  // by edge; at an edge the new triangles come last, as their ids are the highest.
+  EdgeIncidences added(std::vector<Triangle>(oriented.begin() + from, oriented.end()));
+  for (int& t : added.triangle)
+    t += static_cast<int>(from);
   EdgeIncidences merged;
-  merged.edges.reserve(edges.size() + added.size());
-  merged.first.reserve(edges.size() + added.size() + 1);
-  merged.triangle.reserve(triangle.size() + added.size());
-  merged.forward.reserve(triangle.size() + added.size());
-  for (std::size_t e = 0, j = 0; e < edges.size() || j < added.size();) {
+  merged.edges.reserve(edges.size() + added.edges.size());
+  merged.first.reserve(edges.size() + added.edges.size() + 1);
+  merged.triangle.reserve(triangle.size() + added.triangle.size());
+  merged.forward.reserve(triangle.size() + added.triangle.size());
+  const auto take = [&merged](const EdgeIncidences& from_list, std::size_t e) {
+    const auto begin = from_list.first[e], end = from_list.first[e + 1];
+    merged.triangle.insert(merged.triangle.end(),
+                           from_list.triangle.begin() + begin,
+                           from_list.triangle.begin() + end);
+    merged.forward.insert(merged.forward.end(),
+                          from_list.forward.begin() + begin,
+                          from_list.forward.begin() + end);
+  };
+  for (std::size_t e = 0, a = 0; e < edges.size() || a < added.edges.size();) {
     const bool old =
-        j == added.size() || (e < edges.size() && edges[e] <= added[j].edge);
-    const std::array<int, 2> edge = old ? edges[e] : added[j].edge;
+        a == added.edges.size() || (e < edges.size() && edges[e] <= added.edges[a]);
+    const std::array<int, 2> edge = old ? edges[e] : added.edges[a];
     merged.edges.push_back(edge);
     merged.first.push_back(merged.triangle.size());
-    if (old) {
-      merged.triangle.insert(merged.triangle.end(),
-                             triangle.begin() + first[e],
-                             triangle.begin() + first[e + 1]);
-      merged.forward.insert(merged.forward.end(),
-                            forward.begin() + first[e],
-                            forward.begin() + first[e + 1]);
-      ++e;
-    }
-    for (; j < added.size() && added[j].edge == edge; ++j) {
-      merged.triangle.push_back(added[j].triangle);
-      merged.forward.push_back(added[j].forward);
-    }
+    if (old)
+      take(*this, e++);
+    if (a < added.edges.size() && added.edges[a] == edge)
+      take(added, a++);
   }
   merged.first.push_back(merged.triangle.size());
   *this = std::move(merged);

@@ -447,7 +447,9 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       stack.push_back({m, j});
     }
   }
-  if (added && incidences && incidences->grouped())
+  if (incidences && &inc == &grouped)
+    *incidences = std::move(grouped);
+  if (added && incidences)
     incidences->add(triangles, before);
   return added;
 }
