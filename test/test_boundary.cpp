@@ -131,6 +131,42 @@ TEST(LargestAngularGap, SameAsSortingTheAngles)
   EXPECT_DOUBLE_EQ(largestAngularGap({-3.0, 3.0}), 6.0);
 }
 
+TEST(LargestAngularGap, DirectionsAsTheirAngles)
+{
+  // The gap of plane directions is that of their atan2 angles: random directions of
+  // random lengths, few and many, repeated ones, directions on a coarse grid of
+  // angles (exact ties, opposite pairs), zero vectors.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), length(1e-3, 1e3);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<Eigen::Vector2d> d(2 + trial % 40);
+    for (auto& x : d) {
+      double a = angle(random);
+      if (trial % 3 == 0)
+        a = std::round(a * 4.0) / 4.0;
+      x = length(random) * Eigen::Vector2d(std::cos(a), std::sin(a));
+    }
+    if (trial % 5 == 0)
+      d[trial % d.size()] = d[0];
+    if (trial % 7 == 0)
+      d[trial % d.size()].setZero();
+    std::vector<double> a;
+    for (const auto& x : d)
+      a.push_back(std::atan2(x.y(), x.x()));
+    const double expected = largestAngularGap(a);
+    ASSERT_NEAR(largestAngularGap(d), expected, 1e-12 * (1.0 + expected))
+        << d.size() << " directions";
+  }
+  std::vector<Eigen::Vector2d> one{{1.0, 2.0}};
+  EXPECT_EQ(largestAngularGap(one), 2.0 * M_PI);
+  std::vector<Eigen::Vector2d> same{{1.0, 2.0}, {2.0, 4.0}, {0.5, 1.0}};
+  EXPECT_EQ(largestAngularGap(same), 2.0 * M_PI);
+  std::vector<Eigen::Vector2d> opposite{{1.0, 0.0}, {-2.0, 0.0}};
+  EXPECT_DOUBLE_EQ(largestAngularGap(opposite), M_PI);
+  std::vector<Eigen::Vector2d> narrow{{1.0, 1e-9}, {1.0, -1e-9}};
+  EXPECT_NEAR(largestAngularGap(narrow), 2.0 * M_PI - 2e-9, 1e-15);
+}
+
 TEST(HalfDiskTest, GridBorderAndInterior)
 {
   // A 20 x 20 range-grid-like sheet, slightly curved so that the triangulation is

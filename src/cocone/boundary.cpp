@@ -59,7 +59,7 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
 #pragma omp parallel num_threads(threads)
   {
     std::vector<int> ring;
-    std::vector<double> angles;
+    std::vector<Eigen::Vector2d> directions;
     // Per vertex, the last p whose ring took it: each once, without sorting.
     std::vector<int> taken(n, -1);
 #pragma omp for schedule(dynamic, 1024)
@@ -85,12 +85,12 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
         continue;
       const Eigen::Vector3d& pole = cells.pole[p];
       const Eigen::Vector3d e1 = pole.unitOrthogonal(), e2 = pole.cross(e1);
-      angles.clear();
+      directions.clear();
       for (const int q : ring) {
         const Eigen::Vector3d d = points[q] - points[p];
-        angles.push_back(std::atan2(d.dot(e2), d.dot(e1)));
+        directions.emplace_back(d.dot(e1), d.dot(e2));
       }
-      out.gap[p] = largestAngularGap(angles);
+      out.gap[p] = largestAngularGap(directions);
     }
   }
   // Inside a surface the gaps grow with the irregularity of the sample: the median

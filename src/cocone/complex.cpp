@@ -67,6 +67,77 @@ largestAngularGap(const std::vector<double>& angles)
   return gap;
 }
 
+namespace {
+
+/** The diamond angle of (x, y), in [0, 4): it grows with the angle from the x axis
+ * over [0, 2 pi) and costs a division. */
+double
+pseudoAngle(double x, double y)
+{
+  const double s = std::abs(x) + std::abs(y);
+  if (s == 0.0)
+    return 0.0;
+  const double r = y / s;
+  if (x < 0.0)
+    return 2.0 - r;
+  return y < 0.0 ? 4.0 + r : r;
+}
+
+} // namespace
+
+double
+largestAngularGap(std::vector<Eigen::Vector2d>& directions)
+{
+  const std::size_t k = directions.size();
+  if (k < 2)
+    return 2.0 * M_PI;
+  struct Direction {
+    double key;
+    Eigen::Vector2d d;
+  };
+  thread_local std::vector<Direction> sorted;
+  sorted.resize(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const Eigen::Vector2d& d = directions[i];
+    // atan2 (0, 0) is 0: the zero vector points along the x axis.
+    const Eigen::Vector2d u = d.isZero(0.0) ? Eigen::Vector2d::UnitX() : d;
+    // Insertion: a ring has a few dozen directions.
+    std::size_t j = i;
+    const double key = pseudoAngle(u.x(), u.y());
+    for (; j > 0 && sorted[j - 1].key > key; --j)
+      sorted[j] = sorted[j - 1];
+    sorted[j] = {key, u};
+  }
+  // The gap from a to the next direction b, turning anticlockwise, is the angle of
+  // (a.b, a x b), which its pseudo-angle orders. Near a whole turn or none, where
+  // the cross product's sign may be rounding's, the turn of the keys tells the two
+  // apart: below pi a turn of keys stays below 2, above it rises above 2.
+  constexpr double WHOLE = 4.0;
+  std::size_t best = 0;
+  double best_key = -1.0;
+  for (std::size_t i = 0; i < k; ++i) {
+    const Direction& a = sorted[i];
+    const Direction& b = sorted[i + 1 < k ? i + 1 : 0];
+    const double turn = b.key - a.key + (i + 1 < k ? 0.0 : WHOLE);
+    const double dot = a.d.dot(b.d), cross = a.d.x() * b.d.y() - a.d.y() * b.d.x();
+    double key = pseudoAngle(dot, cross);
+    if (dot > 0.0 && cross < 0.0 && turn < 2.0)
+      key = 0.0;
+    else if (dot > 0.0 && cross >= 0.0 && turn > 2.0)
+      key = WHOLE;
+    if (key > best_key) {
+      best_key = key;
+      best = i;
+    }
+  }
+  if (best_key == WHOLE)
+    return 2.0 * M_PI;
+  const Eigen::Vector2d& a = sorted[best].d;
+  const Eigen::Vector2d& b = sorted[best + 1 < k ? best + 1 : 0].d;
+  const double gap = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  return gap < 0.0 ? gap + 2.0 * M_PI : gap;
+}
+
 TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
                                  std::vector<Triangle> triangles,
                                  int threads)
