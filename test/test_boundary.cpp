@@ -154,17 +154,17 @@ TEST(LargestAngularGap, DirectionsAsTheirAngles)
     for (const auto& x : d)
       a.push_back(std::atan2(x.y(), x.x()));
     const double expected = largestAngularGap(a);
-    ASSERT_NEAR(largestAngularGap(d), expected, 1e-12 * (1.0 + expected))
+    ASSERT_NEAR(largestDirectionGap(d), expected, 1e-12 * (1.0 + expected))
         << d.size() << " directions";
   }
   std::vector<Eigen::Vector2d> one{{1.0, 2.0}};
-  EXPECT_EQ(largestAngularGap(one), 2.0 * M_PI);
+  EXPECT_EQ(largestDirectionGap(one), 2.0 * M_PI);
   std::vector<Eigen::Vector2d> same{{1.0, 2.0}, {2.0, 4.0}, {0.5, 1.0}};
-  EXPECT_EQ(largestAngularGap(same), 2.0 * M_PI);
+  EXPECT_EQ(largestDirectionGap(same), 2.0 * M_PI);
   std::vector<Eigen::Vector2d> opposite{{1.0, 0.0}, {-2.0, 0.0}};
-  EXPECT_DOUBLE_EQ(largestAngularGap(opposite), M_PI);
+  EXPECT_DOUBLE_EQ(largestDirectionGap(opposite), M_PI);
   std::vector<Eigen::Vector2d> narrow{{1.0, 1e-9}, {1.0, -1e-9}};
-  EXPECT_NEAR(largestAngularGap(narrow), 2.0 * M_PI - 2e-9, 1e-15);
+  EXPECT_NEAR(largestDirectionGap(narrow), 2.0 * M_PI - 2e-9, 1e-15);
 }
 
 TEST(HalfDiskTest, GridBorderAndInterior)

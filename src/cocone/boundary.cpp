@@ -90,7 +90,7 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
         const Eigen::Vector3d d = points[q] - points[p];
         directions.emplace_back(d.dot(e1), d.dot(e2));
       }
-      out.gap[p] = largestAngularGap(directions);
+      out.gap[p] = largestDirectionGap(directions);
     }
   }
   // Inside a surface the gaps grow with the irregularity of the sample: the median

@@ -86,7 +86,7 @@ pseudoAngle(double x, double y)
 } // namespace
 
 double
-largestAngularGap(std::vector<Eigen::Vector2d>& directions)
+largestDirectionGap(const std::vector<Eigen::Vector2d>& directions)
 {
   const std::size_t k = directions.size();
   if (k < 2)
@@ -113,12 +113,12 @@ largestAngularGap(std::vector<Eigen::Vector2d>& directions)
   // the cross product's sign may be rounding's, the turn of the keys tells the two
   // apart: below pi a turn of keys stays below 2, above it rises above 2.
   constexpr double WHOLE = 4.0;
-  std::size_t best = 0;
-  double best_key = -1.0;
+  double best_key = -1.0, best_dot = 0.0, best_cross = 0.0;
   for (std::size_t i = 0; i < k; ++i) {
+    const bool last = i + 1 == k;
     const Direction& a = sorted[i];
-    const Direction& b = sorted[i + 1 < k ? i + 1 : 0];
-    const double turn = b.key - a.key + (i + 1 < k ? 0.0 : WHOLE);
+    const Direction& b = sorted[last ? 0 : i + 1];
+    const double turn = b.key - a.key + (last ? WHOLE : 0.0);
     const double dot = a.d.dot(b.d), cross = a.d.x() * b.d.y() - a.d.y() * b.d.x();
     double key = pseudoAngle(dot, cross);
     if (dot > 0.0 && cross < 0.0 && turn < 2.0)
@@ -127,14 +127,13 @@ largestAngularGap(std::vector<Eigen::Vector2d>& directions)
       key = WHOLE;
     if (key > best_key) {
       best_key = key;
-      best = i;
+      best_dot = dot;
+      best_cross = cross;
     }
   }
   if (best_key == WHOLE)
     return 2.0 * M_PI;
-  const Eigen::Vector2d& a = sorted[best].d;
-  const Eigen::Vector2d& b = sorted[best + 1 < k ? best + 1 : 0].d;
-  const double gap = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  const double gap = std::atan2(best_cross, best_dot);
   return gap < 0.0 ? gap + 2.0 * M_PI : gap;
 }
 

@@ -200,6 +200,7 @@ public:
     return start_;
   }
 
+  /** Start the next walk from cell \a c. */
   void
   setStartCell(int c)
   {
@@ -479,12 +480,9 @@ private:
   bool
   moveTo(int c, int next)
   {
-    if (!take(next, HELD)) {
-      letGo(c);
-      return false;
-    }
+    const bool taken = take(next, HELD);
     letGo(c);
-    return true;
+    return taken;
   }
 
   /** One step of a walk from finite cell \a cell: the cell across the first facet,

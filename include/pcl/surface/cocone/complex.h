@@ -150,12 +150,11 @@ private:
 double
 largestAngularGap(const std::vector<double>& angles);
 
-/** \brief The same for the angles of plane directions (x, y) from the x axis, as
- * atan2 (y, x) gives them (the zero vector at angle 0), with one atan2 in all: the
- * directions are ordered and their gaps compared by a pseudo-angle. The order of
- * \a directions is changed. */
+/** \brief largestAngularGap() of the angles of plane directions (x, y) from the x
+ * axis, as atan2 (y, x) gives them (the zero vector at angle 0), with one atan2 in all:
+ * the directions are ordered and their gaps compared by a pseudo-angle. */
 double
-largestAngularGap(std::vector<Eigen::Vector2d>& directions);
+largestDirectionGap(const std::vector<Eigen::Vector2d>& directions);
 
 template <typename Alive>
 bool
