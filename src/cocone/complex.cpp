@@ -152,10 +152,12 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
   // Edges: the incidences grouped by edge once. Incidence (t, k) runs from corner k
   // to corner k + 1, so it is the edge opposite corner k + 2.
   const std::vector<std::uint64_t> word =
-      detail::groupEdgeIncidences(triangles_, edges_, edge_first_);
+      detail::groupEdgeIncidences(triangles_, edges_, edge_first_, threads);
   triangle_edges_.resize(m);
   edge_triangles_.resize(word.size());
-  for (std::size_t e = 0; e < edges_.size(); ++e)
+  const auto num_edges = static_cast<std::ptrdiff_t>(edges_.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+  for (std::ptrdiff_t e = 0; e < num_edges; ++e)
     for (std::size_t i = edge_first_[e]; i < edge_first_[e + 1]; ++i) {
       const int t = detail::incidenceTriangle(word[i]);
       triangle_edges_[t][(detail::incidenceCorner(word[i]) + 2) % 3] =
@@ -165,7 +167,6 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Angles about each edge in a frame of the edge.
   edge_angles_.resize(word.size());
-  const auto num_edges = static_cast<std::ptrdiff_t>(edges_.size());
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
   for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
     const Eigen::Vector3d& a = points_[edges_[e][0]];

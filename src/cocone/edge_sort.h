@@ -9,6 +9,10 @@
 
 #include <pcl/surface/cocone/complex.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -33,59 +37,125 @@ incidenceCorner(std::uint64_t word)
   return static_cast<int>(word & 3u);
 }
 
+/** Run body(part) once for every part in [0, parts), on up to \a parts threads.
+ * The body must not throw. */
+template <typename Body>
+void
+forEachPart(int parts, const Body& body)
+{
+#pragma omp parallel num_threads(parts)
+  {
+#ifdef _OPENMP
+    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
+#else
+    const int thread = 0, team = 1;
+#endif
+    for (int part = thread; part < parts; part += team)
+      body(part);
+  }
+}
+
 /** The incidences of the edges of \a triangles grouped by edge. Incidence (t, k) is
  * the edge from triangles[t][k] to triangles[t][(k + 1) % 3], packed as (higher end
  * point << 32 | t << 2 | k). A counting sort on the lower end point, then insertion
  * sorts inside its buckets, which hold a handful of incidences each: one scattering
- * pass. Within an edge the incidences are in triangle order.
+ * pass. Within an edge the incidences are in triangle order. With several threads,
+ * each counts and scatters a part of the triangles, then sorts the buckets of a
+ * part of the vertices: the same result.
  * \param[out] edges the distinct edges, end points ascending, by lower then higher
  * \param[out] first per edge e, its incidences [first[e], first[e + 1]) of the result
  */
 inline std::vector<std::uint64_t>
 groupEdgeIncidences(const std::vector<Triangle>& triangles,
                     std::vector<std::array<int, 2>>& edges,
-                    std::vector<std::size_t>& first)
+                    std::vector<std::size_t>& first,
+                    int threads = 1)
 {
+  const std::size_t m = triangles.size();
   int highest = -1;
   for (const auto& t : triangles)
     highest = std::max({highest, t[0], t[1], t[2]});
-  std::vector<std::uint32_t> start(static_cast<std::size_t>(highest) + 2, 0);
-  for (const auto& t : triangles)
-    for (int k = 0; k < 3; ++k)
-      ++start[std::min(t[k], t[(k + 1) % 3]) + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::uint64_t> word(3 * triangles.size());
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t t = 0; t < triangles.size(); ++t)
+  const std::size_t buckets = static_cast<std::size_t>(highest) + 1;
+  // A part holds some hundred thousand incidences at least.
+  const int parts = static_cast<int>(
+      std::clamp<std::size_t>(m / 32768, 1, static_cast<std::size_t>(threads)));
+  const auto triangle_range = [&](int part) {
+    return std::array<std::size_t, 2>{m * part / parts, m * (part + 1) / parts};
+  };
+  // Per part, per lower end point: the count of its incidences, then where the
+  // part's first one goes (parts in order within a bucket).
+  std::vector<std::vector<std::uint32_t>> place(parts);
+  for (auto& p : place)
+    p.resize(buckets);
+  forEachPart(parts, [&](int part) {
+    auto& count = place[part];
+    std::fill(count.begin(), count.end(), 0);
+    const auto [begin, end] = triangle_range(part);
+    for (std::size_t t = begin; t < end; ++t)
+      for (int k = 0; k < 3; ++k)
+        ++count[std::min(triangles[t][k], triangles[t][(k + 1) % 3])];
+  });
+  std::vector<std::uint32_t> start(buckets + 1);
+  std::uint32_t total = 0;
+  for (std::size_t v = 0; v < buckets; ++v) {
+    start[v] = total;
+    for (auto& p : place) {
+      const std::uint32_t here = p[v];
+      p[v] = total;
+      total += here;
+    }
+  }
+  start[buckets] = total;
+  std::vector<std::uint64_t> word(3 * m);
+  forEachPart(parts, [&](int part) {
+    auto& fill = place[part];
+    const auto [begin, end] = triangle_range(part);
+    for (std::size_t t = begin; t < end; ++t)
       for (std::uint64_t k = 0; k < 3; ++k) {
         const std::uint64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
         word[fill[std::min(a, b)]++] = std::max(a, b) << 32 | t << 2 | k;
       }
-  }
-  std::size_t count = 0;
-  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
-    for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
-      const std::uint64_t w = word[i];
-      std::size_t j = i;
-      for (; j > start[v] && word[j - 1] > w; --j)
-        word[j] = word[j - 1];
-      word[j] = w;
-    }
-    for (std::size_t i = start[v]; i < start[v + 1]; ++i)
-      count += i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
-  }
-  edges.clear();
-  edges.reserve(count);
-  first.clear();
-  first.reserve(count + 1);
-  for (std::size_t v = 0; v + 1 < start.size(); ++v)
-    for (std::size_t i = start[v]; i < start[v + 1]; ++i)
-      if (i == start[v] || word[i] >> 32 != word[i - 1] >> 32) {
-        first.push_back(i);
-        edges.push_back({static_cast<int>(v), static_cast<int>(word[i] >> 32)});
+  });
+  std::vector<std::vector<std::uint32_t>>().swap(place);
+  // Sort the buckets of each part of the vertices, count its edges, then list them.
+  const auto vertex_range = [&](int part) {
+    return std::array<std::size_t, 2>{buckets * part / parts,
+                                      buckets * (part + 1) / parts};
+  };
+  const auto opens_edge = [&](std::size_t v, std::size_t i) {
+    return i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
+  };
+  std::vector<std::size_t> edges_before(parts + 1, 0);
+  forEachPart(parts, [&](int part) {
+    const auto [begin, end] = vertex_range(part);
+    std::size_t count = 0;
+    for (std::size_t v = begin; v < end; ++v) {
+      for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
+        const std::uint64_t w = word[i];
+        std::size_t j = i;
+        for (; j > start[v] && word[j - 1] > w; --j)
+          word[j] = word[j - 1];
+        word[j] = w;
       }
-  first.push_back(word.size());
+      for (std::size_t i = start[v]; i < start[v + 1]; ++i)
+        count += opens_edge(v, i);
+    }
+    edges_before[part + 1] = count;
+  });
+  std::partial_sum(edges_before.begin(), edges_before.end(), edges_before.begin());
+  edges.resize(edges_before[parts]);
+  first.resize(edges_before[parts] + 1);
+  forEachPart(parts, [&](int part) {
+    const auto [begin, end] = vertex_range(part);
+    std::size_t e = edges_before[part];
+    for (std::size_t v = begin; v < end; ++v)
+      for (std::size_t i = start[v]; i < start[v + 1]; ++i)
+        if (opens_edge(v, i)) {
+          first[e] = i;
+          edges[e++] = {static_cast<int>(v), static_cast<int>(word[i] >> 32)};
+        }
+  });
+  first.back() = word.size();
   return word;
 }
 

@@ -50,18 +50,20 @@ struct DisjointSets {
 
 } // namespace
 
-EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented)
+EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented, int threads)
 {
   const std::vector<std::uint64_t> word =
-      detail::groupEdgeIncidences(oriented, edges, first);
+      detail::groupEdgeIncidences(oriented, edges, first, threads);
   triangle.resize(word.size());
   forward.resize(word.size());
-  for (std::size_t e = 0; e < edges.size(); ++e)
-    for (std::size_t i = first[e]; i < first[e + 1]; ++i) {
-      triangle[i] = detail::incidenceTriangle(word[i]);
-      forward[i] =
-          edges[e][0] == oriented[triangle[i]][detail::incidenceCorner(word[i])];
-    }
+  const auto size = static_cast<std::ptrdiff_t>(word.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+  for (std::ptrdiff_t i = 0; i < size; ++i) {
+    const int t = detail::incidenceTriangle(word[i]),
+              k = detail::incidenceCorner(word[i]);
+    triangle[i] = t;
+    forward[i] = oriented[t][k] < oriented[t][(k + 1) % 3];
+  }
 }
 
 void

@@ -149,7 +149,8 @@ orient(const std::vector<Eigen::Vector3d>& P,
        std::vector<Triangle>& triangles,
        const EdgeIncidences& inc,
        std::size_t& flipped,
-       std::vector<std::uint8_t>& turned_over)
+       std::vector<std::uint8_t>& turned_over,
+       int threads)
 {
   // inc's edges and triangles stay valid while triangles are turned over: whether
   // two neighbours run their edge the same way (and so disagree) is read from the
@@ -161,24 +162,32 @@ orient(const std::vector<Eigen::Vector3d>& P,
     turned_over[t] ^= 1;
   };
   // Per triangle, in the order of its edges: the neighbour across each (-1 at a
-  // border edge), and bit k set if neighbour k ran the edge the same way at first.
+  // border edge), and whether it ran the edge the same way at first.
   std::vector<std::array<int, 3>> across(m, {-1, -1, -1});
-  std::vector<std::uint8_t> alike(m, 0);
-  {
-    std::vector<std::uint8_t> filled(m, 0);
-    for (std::size_t e = 0; e < inc.edges.size(); ++e)
-      for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i) {
-        const int t = inc.triangle[i], k = filled[t]++;
-        if (inc.count(e) != 2)
-          continue;
-        const std::size_t j = i == inc.first[e] ? i + 1 : i - 1;
-        across[t][k] = inc.triangle[j];
-        if (inc.forward[i] == inc.forward[j])
-          alike[t] |= static_cast<std::uint8_t>(1u << k);
-      }
+  std::vector<std::array<std::uint8_t, 3>> alike(m, {0, 0, 0});
+  // Edge k of a triangle: the k-th of its edges in ascending order.
+  const auto edge_rank = [&](int t, const std::array<int, 2>& edge) {
+    const auto& v = triangles[t];
+    int k = 0;
+    for (int c = 0; c < 3; ++c) {
+      const int a = v[c], b = v[(c + 1) % 3];
+      k += std::array<int, 2>{std::min(a, b), std::max(a, b)} < edge;
+    }
+    return k;
+  };
+  const auto num_edges = static_cast<std::ptrdiff_t>(inc.edges.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+  for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
+    if (inc.count(e) != 2)
+      continue;
+    for (std::size_t i = inc.first[e], j = i + 1; i < inc.first[e + 1]; ++i, --j) {
+      const int t = inc.triangle[i], k = edge_rank(t, inc.edges[e]);
+      across[t][k] = inc.triangle[j];
+      alike[t][k] = inc.forward[i] == inc.forward[j];
+    }
   }
   const auto disagree = [&](int t, int k) {
-    return (((alike[t] >> k) & 1u) ^ turned_over[t] ^ turned_over[across[t][k]]) != 0;
+    return (alike[t][k] ^ turned_over[t] ^ turned_over[across[t][k]]) != 0;
   };
 
   // Each component grows from its lowest triangle, across the edge whose two
@@ -304,7 +313,7 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                EdgeIncidences* incidences)
 {
   for (;;) {
-    EdgeIncidences inc(triangles);
+    EdgeIncidences inc(triangles, threads);
     if (const std::size_t d = resolveEdges(points, triangles, inc)) {
       counts.nonmanifold_edge += d;
       continue;
@@ -322,9 +331,9 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
     }
     counts.nonmanifold_vertex += dropped;
     if (dropped)
-      inc = EdgeIncidences(triangles);
+      inc = EdgeIncidences(triangles, threads);
     std::vector<std::uint8_t> turned_over;
-    d = orient(points, triangles, inc, counts.flipped, turned_over);
+    d = orient(points, triangles, inc, counts.flipped, turned_over, threads);
     if (d == 0) {
       if (incidences) { // the same edges; the turned triangles run the other way
         for (std::size_t i = 0; i < inc.triangle.size(); ++i)

@@ -27,8 +27,8 @@ struct EdgeIncidences {
   /** None: not grouped yet (see grouped()). */
   EdgeIncidences() = default;
 
-  /** Group the edges of \a oriented. */
-  explicit EdgeIncidences(const std::vector<Triangle>& oriented);
+  /** Group the edges of \a oriented, with up to \a threads threads. */
+  explicit EdgeIncidences(const std::vector<Triangle>& oriented, int threads = 1);
 
   /** Group in the triangles \a oriented [from, end) too, as if grouped with the
    * others from the start (the triangles before \a from are those grouped). Linear
