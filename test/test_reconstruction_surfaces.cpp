@@ -339,7 +339,10 @@ TEST(Repair, FilledHolesLeaveAnOrientedManifold)
   pcl::cocone::repairManifold(P, mesh, counts);
   EXPECT_EQ(counts.dropped(), 0u);
   counts = {};
-  EXPECT_EQ(pcl::cocone::fillHoles(P, mesh, allowed, 6), 3u);
+  const auto is_allowed = [&](const pcl::cocone::Triangle& t) {
+    return std::binary_search(allowed.begin(), allowed.end(), t);
+  };
+  EXPECT_EQ(pcl::cocone::fillHoles(P, mesh, is_allowed, 6), 3u);
   const auto topology = pcl::cocone::analyzeMesh(mesh, P.size());
   EXPECT_TRUE(topology.manifold());
   EXPECT_EQ(pcl::cocone::boundaryLoops(mesh, P.size()).size(), 2u); // outer, (7, 7)
@@ -395,13 +398,64 @@ TEST(Repair, IncidencesHandedOnMatchTheTriangles)
   // the filled mesh from scratch would have them.
   // Loops up to six edges: some holes take diagonals, edges the mesh had not.
   const std::size_t edges_before = inc.edges.size();
-  ASSERT_GT(pcl::cocone::fillHoles(r.positions, mesh, allowed, 6, &inc), 0u);
+  const auto is_allowed = [&](const pcl::cocone::Triangle& t) {
+    return std::binary_search(allowed.begin(), allowed.end(), t);
+  };
+  ASSERT_GT(pcl::cocone::fillHoles(r.positions, mesh, is_allowed, 6, &inc), 0u);
   EXPECT_GT(inc.edges.size(), edges_before);
   expect_grouped(inc, mesh);
   pcl::cocone::dropRibbons(mesh, r.positions.size(), &inc);
   expect_grouped(inc, mesh);
   EXPECT_EQ(pcl::cocone::boundaryLoops(inc, r.positions.size()),
             pcl::cocone::boundaryLoops(mesh, r.positions.size()));
+}
+
+TEST(Repair, IncidencesAddedRemovedAndThreadedAsIfGroupedAgain)
+{
+  using pcl::cocone::EdgeIncidences;
+  using pcl::cocone::Triangle;
+  const auto expect_same = [](const EdgeIncidences& a, const EdgeIncidences& b) {
+    EXPECT_EQ(a.edges, b.edges);
+    EXPECT_EQ(a.first, b.first);
+    EXPECT_EQ(a.triangle, b.triangle);
+    EXPECT_EQ(a.forward, b.forward);
+  };
+  std::mt19937 rng(7);
+  // Random triangles over few vertices: most edges have several triangles, some
+  // added ones meet old edges, some make new ones, before and after the old ones.
+  const auto random_triangles = [&](std::size_t count, int vertices) {
+    std::vector<Triangle> out;
+    std::uniform_int_distribution<int> vertex(0, vertices - 1);
+    while (out.size() < count) {
+      const Triangle t{vertex(rng), vertex(rng), vertex(rng)};
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        out.push_back(t);
+    }
+    return out;
+  };
+  for (int trial = 0; trial < 300; ++trial) {
+    const int vertices = 4 + trial % 40;
+    std::vector<Triangle> mesh = random_triangles(trial % 50, vertices);
+    const std::size_t old = mesh.size();
+    const auto more = random_triangles(trial % 7, vertices + 3);
+    mesh.insert(mesh.end(), more.begin(), more.end());
+    EdgeIncidences grown(std::vector<Triangle>(mesh.begin(), mesh.begin() + old));
+    grown.add(mesh, old);
+    expect_same(grown, EdgeIncidences(mesh));
+
+    std::vector<std::uint8_t> dropped(mesh.size());
+    std::vector<Triangle> kept;
+    for (std::size_t t = 0; t < mesh.size(); ++t) {
+      dropped[t] = (rng() % 3 == 0) || trial % 11 == 0;
+      if (!dropped[t])
+        kept.push_back(mesh[t]);
+    }
+    grown.remove(dropped);
+    expect_same(grown, EdgeIncidences(kept));
+  }
+  // Large enough for several threads to group parts of it.
+  const auto large = random_triangles(200000, 30000);
+  expect_same(EdgeIncidences(large, 3), EdgeIncidences(large, 1));
 }
 
 TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)

@@ -184,19 +184,17 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
     }
   }
 
-  // Vertex -> triangles.
-  const int n = static_cast<int>(points_.size());
-  vertex_first_.assign(n + 1, 0);
-  for (const auto& t : triangles_)
-    for (const int v : t)
-      ++vertex_first_[v + 1];
-  for (int v = 0; v < n; ++v)
-    vertex_first_[v + 1] += vertex_first_[v];
+  // Vertex -> triangles, in ascending order.
   vertex_triangles_.resize(3 * m);
-  std::vector<std::size_t> fill(vertex_first_.begin(), vertex_first_.end() - 1);
-  for (std::size_t t = 0; t < m; ++t)
-    for (const int v : triangles_[t])
-      vertex_triangles_[fill[v]++] = static_cast<int>(t);
+  const std::vector<std::uint32_t> start = detail::sortCorners(
+      triangles_,
+      points_.size(),
+      threads,
+      [](const Triangle& t, int k) { return t[k]; },
+      [&](std::size_t t, int, std::uint32_t place) {
+        vertex_triangles_[place] = static_cast<int>(t);
+      });
+  vertex_first_.assign(start.begin(), start.end());
 }
 
 int

@@ -55,13 +55,74 @@ forEachPart(int parts, const Body& body)
   }
 }
 
+/** Parts for \a threads threads to split \a items triangles into: some ten thousand
+ * triangles a part at least. */
+inline int
+partsFor(std::size_t items, int threads)
+{
+  return static_cast<int>(
+      std::clamp<std::size_t>(items / 32768, 1, static_cast<std::size_t>(threads)));
+}
+
+/** A counting sort of the corners of \a triangles by their vertex, or by any key of
+ * a corner below \a buckets: calls put(t, k, place) for every corner (t, k), in a
+ * place in [0, 3 m) where the corners of one key are together and in ascending
+ * order of (t, k). With several threads, each counts and places the corners of a
+ * part of the triangles.
+ * \return per key b, where its corners begin; then the end (3 m) */
+template <typename Key, typename Put>
+std::vector<std::uint32_t>
+sortCorners(const std::vector<Triangle>& triangles,
+            std::size_t buckets,
+            int threads,
+            const Key& key,
+            const Put& put)
+{
+  const std::size_t m = triangles.size();
+  const int parts = partsFor(m, threads);
+  const auto range = [&](int part) {
+    return std::array<std::size_t, 2>{m * part / parts, m * (part + 1) / parts};
+  };
+  // Per part and key: its count of corners, then where the first of them goes (the
+  // parts in order within a key).
+  std::vector<std::vector<std::uint32_t>> place(parts);
+  for (auto& p : place)
+    p.resize(buckets);
+  forEachPart(parts, [&](int part) {
+    auto& count = place[part];
+    std::fill(count.begin(), count.end(), 0);
+    const auto [begin, end] = range(part);
+    for (std::size_t t = begin; t < end; ++t)
+      for (int k = 0; k < 3; ++k)
+        ++count[key(triangles[t], k)];
+  });
+  std::vector<std::uint32_t> start(buckets + 1);
+  std::uint32_t total = 0;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    start[b] = total;
+    for (auto& p : place) {
+      const std::uint32_t here = p[b];
+      p[b] = total;
+      total += here;
+    }
+  }
+  start[buckets] = total;
+  forEachPart(parts, [&](int part) {
+    auto& next = place[part];
+    const auto [begin, end] = range(part);
+    for (std::size_t t = begin; t < end; ++t)
+      for (int k = 0; k < 3; ++k)
+        put(t, k, next[key(triangles[t], k)]++);
+  });
+  return start;
+}
+
 /** The incidences of the edges of \a triangles grouped by edge. Incidence (t, k) is
  * the edge from triangles[t][k] to triangles[t][(k + 1) % 3], packed as (higher end
  * point << 32 | t << 2 | k). A counting sort on the lower end point, then insertion
  * sorts inside its buckets, which hold a handful of incidences each: one scattering
  * pass. Within an edge the incidences are in triangle order. With several threads,
- * each counts and scatters a part of the triangles, then sorts the buckets of a
- * part of the vertices: the same result.
+ * each sorts the buckets of a part of the vertices too: the same result.
  * \param[out] edges the distinct edges, end points ascending, by lower then higher
  * \param[out] first per edge e, its incidences [first[e], first[e + 1]) of the result
  */
@@ -76,47 +137,17 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
   for (const auto& t : triangles)
     highest = std::max({highest, t[0], t[1], t[2]});
   const std::size_t buckets = static_cast<std::size_t>(highest) + 1;
-  // A part holds some hundred thousand incidences at least.
-  const int parts = static_cast<int>(
-      std::clamp<std::size_t>(m / 32768, 1, static_cast<std::size_t>(threads)));
-  const auto triangle_range = [&](int part) {
-    return std::array<std::size_t, 2>{m * part / parts, m * (part + 1) / parts};
-  };
-  // Per part, per lower end point: the count of its incidences, then where the
-  // part's first one goes (parts in order within a bucket).
-  std::vector<std::vector<std::uint32_t>> place(parts);
-  for (auto& p : place)
-    p.resize(buckets);
-  forEachPart(parts, [&](int part) {
-    auto& count = place[part];
-    std::fill(count.begin(), count.end(), 0);
-    const auto [begin, end] = triangle_range(part);
-    for (std::size_t t = begin; t < end; ++t)
-      for (int k = 0; k < 3; ++k)
-        ++count[std::min(triangles[t][k], triangles[t][(k + 1) % 3])];
-  });
-  std::vector<std::uint32_t> start(buckets + 1);
-  std::uint32_t total = 0;
-  for (std::size_t v = 0; v < buckets; ++v) {
-    start[v] = total;
-    for (auto& p : place) {
-      const std::uint32_t here = p[v];
-      p[v] = total;
-      total += here;
-    }
-  }
-  start[buckets] = total;
   std::vector<std::uint64_t> word(3 * m);
-  forEachPart(parts, [&](int part) {
-    auto& fill = place[part];
-    const auto [begin, end] = triangle_range(part);
-    for (std::size_t t = begin; t < end; ++t)
-      for (std::uint64_t k = 0; k < 3; ++k) {
+  const std::vector<std::uint32_t> start = sortCorners(
+      triangles,
+      buckets,
+      threads,
+      [](const Triangle& t, int k) { return std::min(t[k], t[(k + 1) % 3]); },
+      [&](std::uint64_t t, std::uint64_t k, std::uint32_t place) {
         const std::uint64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-        word[fill[std::min(a, b)]++] = std::max(a, b) << 32 | t << 2 | k;
-      }
-  });
-  std::vector<std::vector<std::uint32_t>>().swap(place);
+        word[place] = std::max(a, b) << 32 | t << 2 | k;
+      });
+  const int parts = partsFor(m, threads);
   // Sort the buckets of each part of the vertices, count its edges, then list them.
   const auto vertex_range = [&](int part) {
     return std::array<std::size_t, 2>{buckets * part / parts,

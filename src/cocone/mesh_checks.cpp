@@ -67,40 +67,102 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented, int thread
 }
 
 void
+EdgeIncidences::remove(const std::vector<std::uint8_t>& dropped)
+{
+  std::vector<int> renumbered(dropped.size(), -1);
+  int kept = 0;
+  for (std::size_t t = 0; t < dropped.size(); ++t)
+    if (!dropped[t])
+      renumbered[t] = kept++;
+  std::size_t e2 = 0, i2 = 0;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const std::size_t begin = first[e], end = first[e + 1];
+    first[e2] = i2;
+    for (std::size_t i = begin; i < end; ++i)
+      if (renumbered[triangle[i]] >= 0) {
+        triangle[i2] = renumbered[triangle[i]];
+        forward[i2++] = forward[i];
+      }
+    if (i2 > first[e2])
+      edges[e2++] = edges[e];
+  }
+  edges.resize(e2);
+  first.resize(e2 + 1);
+  first[e2] = i2;
+  triangle.resize(i2);
+  forward.resize(i2);
+}
+
+void
 EdgeIncidences::add(const std::vector<Triangle>& oriented, std::size_t from)
 {
-  // The new triangles grouped on their own, then one merge of the two groupings
-  // by edge; at an edge the new triangles come last, as their ids are the highest.
+  // The new triangles grouped on their own, then merged in place from the back: the
+  // old lists between two new edges move as one block. At an edge the new triangles
+  // come last, as their ids are the highest.
   EdgeIncidences added(std::vector<Triangle>(oriented.begin() + from, oriented.end()));
   for (int& t : added.triangle)
     t += static_cast<int>(from);
-  EdgeIncidences merged;
-  merged.edges.reserve(edges.size() + added.edges.size());
-  merged.first.reserve(edges.size() + added.edges.size() + 1);
-  merged.triangle.reserve(triangle.size() + added.triangle.size());
-  merged.forward.reserve(triangle.size() + added.triangle.size());
-  const auto take = [&merged](const EdgeIncidences& from_list, std::size_t e) {
-    const auto begin = from_list.first[e], end = from_list.first[e + 1];
-    merged.triangle.insert(merged.triangle.end(),
-                           from_list.triangle.begin() + begin,
-                           from_list.triangle.begin() + end);
-    merged.forward.insert(merged.forward.end(),
-                          from_list.forward.begin() + begin,
-                          from_list.forward.begin() + end);
-  };
-  for (std::size_t e = 0, a = 0; e < edges.size() || a < added.edges.size();) {
-    const bool old =
-        a == added.edges.size() || (e < edges.size() && edges[e] <= added.edges[a]);
-    const std::array<int, 2> edge = old ? edges[e] : added.edges[a];
-    merged.edges.push_back(edge);
-    merged.first.push_back(merged.triangle.size());
-    if (old)
-      take(*this, e++);
-    if (a < added.edges.size() && added.edges[a] == edge)
-      take(added, a++);
+  const std::size_t old_edges = edges.size(), old_incidences = triangle.size();
+  // Per new edge: the old edges before it, and whether it is one of them.
+  std::vector<std::size_t> before(added.edges.size());
+  std::vector<std::uint8_t> twin(added.edges.size());
+  std::size_t fresh = 0;
+  for (std::size_t a = 0; a < added.edges.size(); ++a) {
+    const auto it = std::lower_bound(edges.begin(), edges.end(), added.edges[a]);
+    before[a] = static_cast<std::size_t>(it - edges.begin());
+    twin[a] = it != edges.end() && *it == added.edges[a];
+    fresh += !twin[a];
   }
-  merged.first.push_back(merged.triangle.size());
-  *this = std::move(merged);
+  edges.resize(old_edges + fresh);
+  first.resize(old_edges + fresh + 1);
+  triangle.resize(old_incidences + added.triangle.size());
+  forward.resize(triangle.size());
+  // Old edges [0, e) and their incidences [0, i) are still in their old places; the
+  // merged ones from w and iw on are in their new places.
+  std::size_t e = old_edges, i = old_incidences, w = edges.size(), iw = triangle.size();
+  // Move old edges [to, e) up to end at w. (first[e] may be a merged edge's already.)
+  const auto move_old = [&](std::size_t to) {
+    const std::size_t lists = to == e ? i : first[to];
+    const std::size_t shift = iw - i;
+    std::move_backward(
+        triangle.begin() + lists, triangle.begin() + i, triangle.begin() + iw);
+    std::move_backward(
+        forward.begin() + lists, forward.begin() + i, forward.begin() + iw);
+    for (std::size_t k = e; k-- > to;) {
+      --w;
+      edges[w] = edges[k];
+      first[w] = first[k] + shift;
+    }
+    iw -= i - lists;
+    i = lists;
+    e = to;
+  };
+  first.back() = triangle.size();
+  for (std::size_t a = added.edges.size(); a-- > 0;) {
+    move_old(before[a] + twin[a]);
+    // The new incidences of the edge, after its old ones if it had any.
+    const std::size_t begin = added.first[a], end = added.first[a + 1];
+    iw -= end - begin;
+    std::copy(added.triangle.begin() + begin,
+              added.triangle.begin() + end,
+              triangle.begin() + iw);
+    std::copy(added.forward.begin() + begin,
+              added.forward.begin() + end,
+              forward.begin() + iw);
+    if (twin[a]) {
+      const std::size_t lists = first[e - 1];
+      std::move_backward(
+          triangle.begin() + lists, triangle.begin() + i, triangle.begin() + iw);
+      std::move_backward(
+          forward.begin() + lists, forward.begin() + i, forward.begin() + iw);
+      iw -= i - lists;
+      i = lists;
+      --e;
+    }
+    --w;
+    edges[w] = added.edges[a];
+    first[w] = iw;
+  }
 }
 
 std::vector<int>
@@ -112,18 +174,18 @@ vertexFans(const std::vector<Triangle>& oriented,
   // Corners (t, k) sorted by vertex; two corners of a vertex share a fan when their
   // triangles share an edge at the vertex.
   const std::size_t m = oriented.size();
-  std::vector<int> corner_first(num_vertices + 1, 0), corners(3 * m);
-  for (const auto& t : oriented)
-    for (const int v : t)
-      ++corner_first[v + 1];
-  for (std::size_t v = 0; v < num_vertices; ++v)
-    corner_first[v + 1] += corner_first[v];
-  std::vector<int> fill(corner_first.begin(), corner_first.end() - 1);
-  for (std::size_t t = 0; t < m; ++t)
-    for (int k = 0; k < 3; ++k)
-      corners[fill[oriented[t][k]]++] = static_cast<int>(3 * t + k);
+  std::vector<int> corners(3 * m);
+  const std::vector<std::uint32_t> corner_first = detail::sortCorners(
+      oriented,
+      num_vertices,
+      threads,
+      [](const Triangle& t, int k) { return t[k]; },
+      [&](std::size_t t, int k, std::uint32_t place) {
+        corners[place] = static_cast<int>(3 * t + k);
+      });
 
   std::vector<int> fan(3 * m, -1);
+  constexpr int SMALL_STAR = 12;
   if (fans_per_vertex)
     fans_per_vertex->assign(num_vertices, 0);
 #pragma omp parallel num_threads(threads)
@@ -143,10 +205,23 @@ vertexFans(const std::vector<Triangle>& oriented,
         others.emplace_back(oriented[t][(k + 1) % 3], i);
         others.emplace_back(oriented[t][(k + 2) % 3], i);
       }
-      std::sort(others.begin(), others.end());
-      for (std::size_t j = 1; j < others.size(); ++j)
-        if (others[j].first == others[j - 1].first)
-          sets.unite(others[j].second, others[j - 1].second);
+      if (size <= SMALL_STAR) {
+        // A few triangles: compare every two, cheaper than sorting.
+        for (int i = 1; i < size; ++i)
+          for (int j = 0; j < i; ++j) {
+            const auto &a = others[2 * i], &b = others[2 * i + 1];
+            const auto &c = others[2 * j], &d = others[2 * j + 1];
+            if (a.first == c.first || a.first == d.first || b.first == c.first ||
+                b.first == d.first)
+              sets.unite(i, j);
+          }
+      }
+      else {
+        std::sort(others.begin(), others.end());
+        for (std::size_t j = 1; j < others.size(); ++j)
+          if (others[j].first == others[j - 1].first)
+            sets.unite(others[j].second, others[j - 1].second);
+      }
       id.assign(size, -1);
       int fans = 0;
       for (int i = 0; i < size; ++i) {

@@ -88,17 +88,25 @@ reconstruct(Triangulation& dt,
   EdgeIncidences incidences;
   repairManifold(dt.points, result.triangles, counts.repair, threads, &incidences);
   if (parameters.fill_hole_edges >= 3) {
-    std::vector<Triangle> delaunay;
-    delaunay.reserve(cells.triangles.size());
-    for (const auto& t : cells.triangles)
-      delaunay.push_back(t.v);
+    // A hole is closed with triangles whose dual Voronoi edge meets a co-cone.
+    const auto cocone_triangle = [&](const Triangle& t) {
+      const auto it = std::lower_bound(
+          cells.triangles.begin(),
+          cells.triangles.end(),
+          t,
+          [](const CoconeTriangle& a, const Triangle& b) { return a.v < b; });
+      return it != cells.triangles.end() && it->v == t;
+    };
     // No second repair: a hole is a simple loop of border edges (every vertex of
     // the repaired mesh has one fan), its triangles add no edge the mesh has and run
     // against the loop, so the mesh stays an oriented manifold (checked on the
     // tests, the synthetic table and the range scans: a repair after filling never
     // changed a triangle).
-    counts.repair.filled = fillHoles(
-        dt.points, result.triangles, delaunay, parameters.fill_hole_edges, &incidences);
+    counts.repair.filled = fillHoles(dt.points,
+                                     result.triangles,
+                                     cocone_triangle,
+                                     parameters.fill_hole_edges,
+                                     &incidences);
   }
   counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size(), &incidences);
   // The borders, in vertex ids (neither the order of the triangles nor the corner

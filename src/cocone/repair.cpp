@@ -26,9 +26,12 @@ unitNormal(const std::vector<Eigen::Vector3d>& P, const Triangle& t)
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
 }
 
-/** Remove the triangles marked in drop; returns how many. */
+/** Remove the triangles marked in drop, from \a inc too if given; returns how
+ * many. */
 std::size_t
-compact(std::vector<Triangle>& triangles, const std::vector<std::uint8_t>& drop)
+compact(std::vector<Triangle>& triangles,
+        const std::vector<std::uint8_t>& drop,
+        EdgeIncidences* inc = nullptr)
 {
   std::size_t j = 0;
   for (std::size_t t = 0; t < triangles.size(); ++t)
@@ -36,6 +39,8 @@ compact(std::vector<Triangle>& triangles, const std::vector<std::uint8_t>& drop)
       triangles[j++] = triangles[t];
   const std::size_t dropped = triangles.size() - j;
   triangles.resize(j);
+  if (inc && dropped)
+    inc->remove(drop);
   return dropped;
 }
 
@@ -56,7 +61,7 @@ incidencesOf(const std::vector<Triangle>& triangles,
 std::size_t
 resolveEdges(const std::vector<Eigen::Vector3d>& P,
              std::vector<Triangle>& triangles,
-             const EdgeIncidences& inc)
+             EdgeIncidences& inc)
 {
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   bool any = false;
@@ -84,7 +89,7 @@ resolveEdges(const std::vector<Eigen::Vector3d>& P,
         any = true;
       }
   }
-  return any ? compact(triangles, drop) : 0;
+  return any ? compact(triangles, drop, &inc) : 0;
 }
 
 /** At every vertex with several fans keep the largest; with \a only, at the vertices
@@ -92,6 +97,7 @@ resolveEdges(const std::vector<Eigen::Vector3d>& P,
  * triangles are marked in \a touched. */
 std::size_t
 resolveVertices(std::vector<Triangle>& triangles,
+                EdgeIncidences& inc,
                 std::size_t num_vertices,
                 int threads,
                 const std::vector<std::uint8_t>* only,
@@ -139,24 +145,23 @@ resolveVertices(std::vector<Triangle>& triangles,
         touched[w] = 1;
     }
   }
-  return compact(triangles, drop);
+  return compact(triangles, drop, &inc);
 }
 
 /** Orient each component consistently and outward; returns triangles that could not
- * be oriented (dropped). */
+ * be oriented (dropped). \a inc follows. */
 std::size_t
 orient(const std::vector<Eigen::Vector3d>& P,
        std::vector<Triangle>& triangles,
-       const EdgeIncidences& inc,
+       EdgeIncidences& inc,
        std::size_t& flipped,
-       std::vector<std::uint8_t>& turned_over,
        int threads)
 {
   // inc's edges and triangles stay valid while triangles are turned over: whether
   // two neighbours run their edge the same way (and so disagree) is read from the
   // incidences once, and follows from the turns since.
   const std::size_t m = triangles.size();
-  turned_over.assign(m, 0); // each turn toggles it
+  std::vector<std::uint8_t> turned_over(m, 0); // each turn toggles it
   const auto turn = [&](int t) {
     std::swap(triangles[t][1], triangles[t][2]);
     turned_over[t] ^= 1;
@@ -300,7 +305,10 @@ orient(const std::vector<Eigen::Vector3d>& P,
         turn(t);
     ++c;
   }
-  return compact(triangles, drop);
+  // The same edges; the turned triangles run them the other way.
+  for (std::size_t i = 0; i < inc.triangle.size(); ++i)
+    inc.forward[i] ^= turned_over[inc.triangle[i]];
+  return compact(triangles, drop, &inc);
 }
 
 } // namespace
@@ -312,8 +320,9 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                int threads,
                EdgeIncidences* incidences)
 {
+  // Grouped once: each step that drops triangles takes them out of the grouping.
+  EdgeIncidences inc(triangles, threads);
   for (;;) {
-    EdgeIncidences inc(triangles, threads);
     if (const std::size_t d = resolveEdges(points, triangles, inc)) {
       counts.nonmanifold_edge += d;
       continue;
@@ -323,23 +332,17 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
     std::vector<std::uint8_t> touched, again;
     std::size_t dropped = 0;
     std::size_t d =
-        resolveVertices(triangles, points.size(), threads, nullptr, touched);
+        resolveVertices(triangles, inc, points.size(), threads, nullptr, touched);
     while (d > 0) {
       dropped += d;
-      d = resolveVertices(triangles, points.size(), threads, &touched, again);
+      d = resolveVertices(triangles, inc, points.size(), threads, &touched, again);
       touched.swap(again);
     }
     counts.nonmanifold_vertex += dropped;
-    if (dropped)
-      inc = EdgeIncidences(triangles, threads);
-    std::vector<std::uint8_t> turned_over;
-    d = orient(points, triangles, inc, counts.flipped, turned_over, threads);
+    d = orient(points, triangles, inc, counts.flipped, threads);
     if (d == 0) {
-      if (incidences) { // the same edges; the turned triangles run the other way
-        for (std::size_t i = 0; i < inc.triangle.size(); ++i)
-          inc.forward[i] ^= turned_over[inc.triangle[i]];
+      if (incidences)
         *incidences = std::move(inc);
-      }
       return;
     }
     counts.orientation += d;
@@ -349,7 +352,7 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
 std::size_t
 fillHoles(const std::vector<Eigen::Vector3d>& points,
           std::vector<Triangle>& triangles,
-          const std::vector<Triangle>& allowed,
+          const std::function<bool(const Triangle&)>& allowed,
           std::size_t max_edges,
           EdgeIncidences* incidences)
 {
@@ -410,8 +413,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
     const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
       Triangle key{loop[i], loop[m], loop[j]};
       std::sort(key.begin(), key.end());
-      if (!std::binary_search(allowed.begin(), allowed.end(), key) ||
-          had(loop[i], loop[m], loop[j]))
+      if (!allowed(key) || had(loop[i], loop[m], loop[j]))
         return false;
       const auto diagonal = [&](std::size_t a, std::size_t b) {
         return b - a >= 2 && !(a == 0 && b == k - 1);
@@ -484,12 +486,9 @@ dropRibbons(std::vector<Triangle>& triangles,
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   for (std::size_t t = 0; t < triangles.size(); ++t)
     drop[t] = !inner[component[t]];
-  const std::size_t dropped = compact(triangles, drop);
-  if (incidences && dropped)
-    *incidences = EdgeIncidences(triangles);
-  else if (incidences && &inc == &grouped)
+  if (incidences && &inc == &grouped)
     *incidences = std::move(grouped);
-  return dropped;
+  return compact(triangles, drop, incidences);
 }
 
 } // namespace cocone

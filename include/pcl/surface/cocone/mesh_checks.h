@@ -36,6 +36,12 @@ struct EdgeIncidences {
   void
   add(const std::vector<Triangle>& oriented, std::size_t from);
 
+  /** Take out the triangles marked in \a dropped and number the others as they
+   * keep their order, as if grouped again after removing the marked ones from the
+   * list. One pass over the incidences. */
+  void
+  remove(const std::vector<std::uint8_t>& dropped);
+
   /** Whether these are a grouping (of no triangle, too) rather than none. */
   bool
   grouped() const

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <vector>
 
 namespace pcl {
@@ -65,8 +66,9 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                int threads = 1,
                EdgeIncidences* incidences = nullptr);
 
-/** \brief Close border loops of at most \a max_edges edges by triangles from
- * \a allowed (sorted vertex triples, ascending), oriented with their neighbours.
+/** \brief Close border loops of at most \a max_edges edges by triangles that
+ * \a allowed accepts (given their vertex ids ascending), oriented with their
+ * neighbours.
  *
  * On noisy samples most spurious holes are one missing triangle. Each loop is
  * triangulated with the least total perimeter among the triangulations whose
@@ -82,7 +84,7 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
 std::size_t
 fillHoles(const std::vector<Eigen::Vector3d>& points,
           std::vector<Triangle>& triangles,
-          const std::vector<Triangle>& allowed,
+          const std::function<bool(const Triangle&)>& allowed,
           std::size_t max_edges = 3,
           EdgeIncidences* incidences = nullptr);
 
