@@ -8,6 +8,9 @@
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
 #include <pcl/surface/cocone/repair.h>
+#include <pcl/surface/cocone/triangulation.h>
+#include <pcl/surface/cocone/voronoi_cell.h>
+#include <pcl/surface/cocone/walk.h>
 
 #include <gtest/gtest.h>
 
@@ -456,6 +459,38 @@ TEST(Repair, IncidencesAddedRemovedAndThreadedAsIfGroupedAgain)
   // Large enough for several threads to group parts of it.
   const auto large = random_triangles(200000, 30000);
   expect_same(EdgeIncidences(large, 3), EdgeIncidences(large, 1));
+}
+
+TEST(Walk, IncidencesReadOffTheComplexAsIfGrouped)
+{
+  // The co-cone triangles of a noisy saddle, all present: edges with three and more
+  // triangles, of which the walk takes some; enough for three threads to read parts.
+  const auto s = cocone_test::monkeySaddle(options(70000, 0.1));
+  auto unique = pcl::cocone::makeUniquePoints(s.points);
+  const auto dt = pcl::cocone::triangulate(std::move(unique.points));
+  const auto cells = pcl::cocone::computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
+  std::vector<pcl::cocone::Triangle> triangles;
+  for (const auto& t : cells.triangles)
+    triangles.push_back(t.v);
+  const pcl::cocone::TriangleComplex complex(dt.points, triangles);
+  const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
+  const std::vector<std::uint8_t> boundary(dt.points.size(), 0);
+  const auto walked = pcl::cocone::walk(complex, present, boundary);
+  ASSERT_EQ(walked.ids.size(), walked.triangles.size());
+  ASSERT_GT(walked.triangles.size(), 10000u);
+  ASSERT_LT(walked.triangles.size(), complex.numTriangles());
+  const pcl::cocone::EdgeIncidences fresh(walked.triangles);
+  std::size_t crowded = 0;
+  for (std::size_t e = 0; e < fresh.edges.size(); ++e)
+    crowded += fresh.count(e) > 2;
+  EXPECT_GT(crowded, 0u);
+  for (const int threads : {1, 3}) {
+    const auto read = pcl::cocone::walkedIncidences(complex, walked, threads);
+    EXPECT_EQ(read.edges, fresh.edges);
+    EXPECT_EQ(read.first, fresh.first);
+    EXPECT_EQ(read.triangle, fresh.triangle);
+    EXPECT_EQ(read.forward, fresh.forward);
+  }
 }
 
 TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)

@@ -82,10 +82,10 @@ reconstruct(Triangulation& dt,
   counts.walk_conflicts = walked.conflicts;
   counts.walk_reseeds = walked.reseeds;
 
+  // Read off the complex, then kept by the repair, the edge incidences serve the
+  // steps after it.
+  EdgeIncidences incidences = walkedIncidences(complex, walked, threads);
   result.triangles = std::move(walked.triangles);
-  // Grouped by the repair, the edge incidences serve the steps after it until one
-  // changes the triangles.
-  EdgeIncidences incidences;
   repairManifold(dt.points, result.triangles, counts.repair, threads, &incidences);
   if (parameters.fill_hole_edges >= 3) {
     // A hole is closed with triangles whose dual Voronoi edge meets a co-cone.

@@ -321,7 +321,9 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                EdgeIncidences* incidences)
 {
   // Grouped once: each step that drops triangles takes them out of the grouping.
-  EdgeIncidences inc(triangles, threads);
+  EdgeIncidences inc = incidences && incidences->grouped()
+                           ? std::move(*incidences)
+                           : EdgeIncidences(triangles, threads);
   for (;;) {
     if (const std::size_t d = resolveEdges(points, triangles, inc)) {
       counts.nonmanifold_edge += d;

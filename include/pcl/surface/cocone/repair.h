@@ -56,8 +56,9 @@ struct RepairCounts {
  * \param[in,out] triangles oriented triangles
  * \param[in,out] counts what was changed (added to)
  * \param[in] threads threads for the vertex fans
- * \param[out] incidences if given, the edge incidences of the repaired triangles,
- *             for fillHoles() to go on with
+ * \param[in,out] incidences if given and not empty, the edge incidences of
+ *                \a triangles (grouped here otherwise); if given, on return those of
+ *                the repaired triangles, for fillHoles() to go on with
  */
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/mesh_checks.h>
 
 #include <cstdint>
 #include <vector>
@@ -17,6 +18,8 @@ namespace cocone {
 struct WalkResult {
   /** Oriented triangles (vertex ids), in the order the walk reached them. */
   std::vector<Triangle> triangles;
+  /** Per triangle its id in the complex. */
+  std::vector<int> ids;
   /** Connected components of the pruned complex (one walk each). */
   std::size_t components = 0;
   /** Triangles reached again through another edge with the opposite orientation. */
@@ -56,6 +59,11 @@ WalkResult
 walk(const TriangleComplex& complex,
      const std::vector<std::uint8_t>& present,
      const std::vector<std::uint8_t>& boundary);
+
+/** \brief The edge incidences of the walk's triangles, as EdgeIncidences would group
+ * them, read off the complex's grouping with up to \a threads threads. */
+EdgeIncidences
+walkedIncidences(const TriangleComplex& complex, const WalkResult& walked, int threads);
 
 } // namespace cocone
 } // namespace pcl
