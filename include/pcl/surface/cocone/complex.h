@@ -19,8 +19,9 @@ using Triangle = std::array<int, 3>;
 /** \brief A triangle complex with its edges and incidences, as flat arrays.
  *
  * Stages 5-7 (umbrella check, pruning, walk) work on the candidate triangles
- * through this structure. Every triangle incident to an edge carries its angle about
- * the edge, which gives the circular order around the edge.
+ * through this structure. At an edge of more than two triangles each carries its
+ * angle about the edge, which gives their circular order; of an edge of two, whether
+ * they make an angle below pi / 2 is kept.
  */
 class TriangleComplex {
 public:
@@ -73,7 +74,7 @@ public:
     return edges_[e];
   }
 
-  /** Range [first, last) of incidences of edge e in edgeTriangle() / edgeAngle(). */
+  /** Range [first, last) of incidences of edge e in edgeTriangle(). */
   std::size_t
   edgeBegin(int e) const
   {
@@ -92,13 +93,6 @@ public:
   edgeTriangle(std::size_t i) const
   {
     return edge_triangles_[i];
-  }
-
-  /** Angle of the triangle of incidence i about its edge, in [-pi, pi]. */
-  double
-  edgeAngle(std::size_t i) const
-  {
-    return edge_angles_[i];
   }
 
   /** Range of triangles incident to vertex v in vertexTriangle(). */
@@ -140,7 +134,11 @@ private:
   std::vector<std::array<int, 2>> edges_;
   std::vector<std::size_t> edge_first_;
   std::vector<int> edge_triangles_;
+  /** Per incidence of an edge of more than two triangles: its angle about the edge,
+   * in [-pi, pi]. */
   std::vector<double> edge_angles_;
+  /** Per edge of two triangles: they make an angle below pi / 2. */
+  std::vector<std::uint8_t> acute_pair_;
   std::vector<std::size_t> vertex_first_;
   std::vector<int> vertex_triangles_;
 };
@@ -160,9 +158,15 @@ template <typename Alive>
 bool
 TriangleComplex::isSharp(int e, const Alive& alive) const
 {
+  const std::size_t first = edgeBegin(e);
+  if (edgeEnd(e) - first == 2) {
+    // The gap between two is above 3 pi / 2 when the angle they make is below pi / 2.
+    const bool a = alive(edge_triangles_[first]), b = alive(edge_triangles_[first + 1]);
+    return a != b || (a && acute_pair_[e]);
+  }
   thread_local std::vector<double> angles;
   angles.clear();
-  for (std::size_t i = edgeBegin(e); i < edgeEnd(e); ++i)
+  for (std::size_t i = first; i < edgeEnd(e); ++i)
     if (alive(edge_triangles_[i]))
       angles.push_back(edge_angles_[i]);
   if (angles.empty())
