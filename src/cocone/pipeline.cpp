@@ -76,7 +76,7 @@ reconstruct(Triangulation& dt,
 
   const std::vector<std::uint8_t> present =
       prune(complex, boundary, &counts.pruned, umbrella_triangles);
-  WalkResult walked = walk(complex, present, boundary);
+  WalkResult walked = walk(complex, present, boundary, threads);
   counts.walk_components = walked.components;
   counts.walked = walked.triangles.size();
   counts.walk_conflicts = walked.conflicts;

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <utility>
 
@@ -62,19 +63,57 @@ surfaceNeighbor(const TriangleComplex& complex,
 WalkResult
 walk(const TriangleComplex& complex,
      const std::vector<std::uint8_t>& present,
-     const std::vector<std::uint8_t>& boundary)
+     const std::vector<std::uint8_t>& boundary,
+     int threads)
 {
   const int m = static_cast<int>(complex.numTriangles());
   WalkResult out;
 
-  // Connected components of the present triangles (through shared edges).
-  std::vector<int> component(m, -1), stack;
-  std::vector<int> seeds;
-  std::vector<int> edge_count(complex.numEdges(), 0);
-  for (int t = 0; t < m; ++t)
-    if (present[t])
-      for (const int e : complex.triangleEdges(t))
-        ++edge_count[e];
+  // Connected components of the present triangles (through shared edges), by a
+  // union-find over the edges in parallel: a set's root is its lowest triangle, as
+  // the larger of two roots is linked below the smaller.
+  const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
+  std::vector<int> parent(m);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int t) {
+    for (;;) {
+      const int up = __atomic_load_n(&parent[t], __ATOMIC_RELAXED);
+      if (up == t)
+        return t;
+      // Halve the path: any ancestor stays in the set.
+      const int above = __atomic_load_n(&parent[up], __ATOMIC_RELAXED);
+      if (above != up)
+        __atomic_store_n(&parent[t], above, __ATOMIC_RELAXED);
+      t = above;
+    }
+  };
+  std::vector<int> edge_count(num_edges, 0);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+  for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
+    int first = -1;
+    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+      int t = complex.edgeTriangle(i);
+      if (!present[t])
+        continue;
+      ++edge_count[e];
+      if (first < 0) {
+        first = t;
+        continue;
+      }
+      for (int s = first;;) {
+        s = root(s);
+        t = root(t);
+        if (s == t)
+          break;
+        if (s > t)
+          std::swap(s, t);
+        int expected = t;
+        if (__atomic_compare_exchange_n(
+                &parent[t], &expected, s, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+          break;
+      }
+    }
+  }
   const auto score = [&](int t) {
     const auto& v = complex.triangle(t);
     const bool umbrellas = !boundary[v[0]] && !boundary[v[1]] && !boundary[v[2]];
@@ -83,32 +122,28 @@ walk(const TriangleComplex& complex,
       manifold = manifold && edge_count[e] == 2;
     return 2 * umbrellas + manifold;
   };
-  for (int s = 0; s < m; ++s) {
-    if (!present[s] || component[s] >= 0)
+  // Per component (at its root) its seed: the best score, then the lowest triangle.
+  std::vector<std::uint64_t> best(m, 0);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+  for (int t = 0; t < m; ++t) {
+    if (!present[t])
       continue;
-    const int c = static_cast<int>(seeds.size());
-    int seed = s, seed_score = score(s);
-    component[s] = c;
-    stack.assign(1, s);
-    while (!stack.empty()) {
-      const int t = stack.back();
-      stack.pop_back();
-      const int sc = score(t);
-      if (sc > seed_score || (sc == seed_score && t < seed)) {
-        seed = t;
-        seed_score = sc;
-      }
-      for (const int e : complex.triangleEdges(t))
-        for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
-          const int t2 = complex.edgeTriangle(i);
-          if (present[t2] && component[t2] < 0) {
-            component[t2] = c;
-            stack.push_back(t2);
-          }
-        }
+    const std::uint64_t key =
+        std::uint64_t(score(t) + 1) << 32 | static_cast<std::uint32_t>(m - t);
+    std::uint64_t* target = &best[root(t)];
+    std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+    while (key > seen &&
+           !__atomic_compare_exchange_n(
+               target, &seen, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
     }
-    seeds.push_back(seed);
   }
+  // The components in the order of their lowest triangles.
+  std::vector<int> seeds;
+  for (int t = 0; t < m; ++t)
+    if (present[t] && parent[t] == t)
+      seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
+  std::vector<std::uint64_t>().swap(best);
+  std::vector<int>().swap(parent);
   out.components = seeds.size();
 
   // The walk, as in the paper: every edge is processed once.

@@ -54,11 +54,13 @@ surfaceNeighbor(const TriangleComplex& complex,
  * \param[in] complex the candidate triangles
  * \param[in] present per triangle: survived pruning
  * \param[in] boundary per vertex: B plus the umbrella failures
+ * \param[in] threads threads to find the components with (the same walk)
  */
 WalkResult
 walk(const TriangleComplex& complex,
      const std::vector<std::uint8_t>& present,
-     const std::vector<std::uint8_t>& boundary);
+     const std::vector<std::uint8_t>& boundary,
+     int threads = 1);
 
 /** \brief The edge incidences of the walk's triangles, as EdgeIncidences would group
  * them, read off the complex's grouping with up to \a threads threads. */
