@@ -50,7 +50,8 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
   // The short Delaunay edges at p: its nearest neighbours within reach.
   const auto& nearest = cells.nearest;
   std::vector<std::uint8_t> degree(n, 0);
-  for (std::size_t p = 0; p < n; ++p)
+#pragma omp parallel for num_threads(threads) schedule(static, 4096)
+  for (std::ptrdiff_t p = 0; p < static_cast<std::ptrdiff_t>(n); ++p)
     while (degree[p] < nearest[p].size() && near(p, nearest[p][degree[p]]))
       ++degree[p];
 

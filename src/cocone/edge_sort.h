@@ -55,46 +55,40 @@ forEachPart(int parts, const Body& body)
   }
 }
 
-/** Parts for \a threads threads to split \a items triangles into: some ten thousand
- * triangles a part at least. */
+/** Parts for \a threads threads to split \a items into: some sixty thousand items a
+ * part at least. */
 inline int
 partsFor(std::size_t items, int threads)
 {
   return static_cast<int>(
-      std::clamp<std::size_t>(items / 32768, 1, static_cast<std::size_t>(threads)));
+      std::clamp<std::size_t>(items / 65536, 1, static_cast<std::size_t>(threads)));
 }
 
-/** A counting sort of the corners of \a triangles by their vertex, or by any key of
- * a corner below \a buckets: calls put(t, k, place) for every corner (t, k), in a
- * place in [0, 3 m) where the corners of one key are together and in ascending
- * order of (t, k). With several threads, each counts and places the corners of a
- * part of the triangles.
- * \return per key b, where its corners begin; then the end (3 m) */
+/** A stable counting sort of the items [0, count) by key(i), below \a buckets: calls
+ * put(i, place) for every item, where the places of one key are together and in
+ * ascending order of the items. With several threads, each counts and places a part
+ * of the items: the same places.
+ * \return per key b, where its items begin; then the end (count) */
 template <typename Key, typename Put>
 std::vector<std::uint32_t>
-sortCorners(const std::vector<Triangle>& triangles,
-            std::size_t buckets,
-            int threads,
-            const Key& key,
-            const Put& put)
+countingSort(
+    std::size_t count, std::size_t buckets, int threads, const Key& key, const Put& put)
 {
-  const std::size_t m = triangles.size();
-  const int parts = partsFor(m, threads);
+  const int parts = partsFor(count, threads);
   const auto range = [&](int part) {
-    return std::array<std::size_t, 2>{m * part / parts, m * (part + 1) / parts};
+    return std::array<std::size_t, 2>{count * part / parts, count * (part + 1) / parts};
   };
-  // Per part and key: its count of corners, then where the first of them goes (the
+  // Per part and key: its count of items, then where the first of them goes (the
   // parts in order within a key).
   std::vector<std::vector<std::uint32_t>> place(parts);
   for (auto& p : place)
     p.resize(buckets);
   forEachPart(parts, [&](int part) {
-    auto& count = place[part];
-    std::fill(count.begin(), count.end(), 0);
+    auto& counted = place[part];
+    std::fill(counted.begin(), counted.end(), 0);
     const auto [begin, end] = range(part);
-    for (std::size_t t = begin; t < end; ++t)
-      for (int k = 0; k < 3; ++k)
-        ++count[key(triangles[t], k)];
+    for (std::size_t i = begin; i < end; ++i)
+      ++counted[key(i)];
   });
   std::vector<std::uint32_t> start(buckets + 1);
   std::uint32_t total = 0;
@@ -110,11 +104,31 @@ sortCorners(const std::vector<Triangle>& triangles,
   forEachPart(parts, [&](int part) {
     auto& next = place[part];
     const auto [begin, end] = range(part);
-    for (std::size_t t = begin; t < end; ++t)
-      for (int k = 0; k < 3; ++k)
-        put(t, k, next[key(triangles[t], k)]++);
+    for (std::size_t i = begin; i < end; ++i)
+      put(i, next[key(i)]++);
   });
   return start;
+}
+
+/** countingSort() of the corners (t, k) of \a triangles by key(triangles[t], k):
+ * put(t, k, place).
+ * \return per key b, where its corners begin; then the end (3 m) */
+template <typename Key, typename Put>
+std::vector<std::uint32_t>
+sortCorners(const std::vector<Triangle>& triangles,
+            std::size_t buckets,
+            int threads,
+            const Key& key,
+            const Put& put)
+{
+  return countingSort(
+      3 * triangles.size(),
+      buckets,
+      threads,
+      [&](std::size_t c) { return key(triangles[c / 3], static_cast<int>(c % 3)); },
+      [&](std::size_t c, std::uint32_t place) {
+        put(c / 3, static_cast<int>(c % 3), place);
+      });
 }
 
 /** The incidences of the edges of \a triangles grouped by edge. Incidence (t, k) is
@@ -147,7 +161,7 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
         const std::uint64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
         word[place] = std::max(a, b) << 32 | t << 2 | k;
       });
-  const int parts = partsFor(m, threads);
+  const int parts = partsFor(3 * m, threads);
   // Sort the buckets of each part of the vertices, count its edges, then list them.
   const auto vertex_range = [&](int part) {
     return std::array<std::size_t, 2>{buckets * part / parts,
@@ -192,25 +206,27 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
 
 /** Sort \a items by the vertex ids key(item) (lexicographically; the first id below
  * \a n): a counting sort on the first id, then each bucket, a handful of items, on
- * its own. The order of std::sort by the keys where they differ, in linear time. */
+ * its own. The order of std::sort by the keys where they differ, in linear time, and
+ * with several threads the same order.
+ */
 template <typename T, typename Key>
 void
-sortByVertexIds(std::vector<T>& items, std::size_t n, const Key& key)
+sortByVertexIds(std::vector<T>& items, std::size_t n, const Key& key, int threads = 1)
 {
-  std::vector<std::uint32_t> start(n + 1, 0);
-  for (const T& x : items)
-    ++start[key(x)[0] + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
   std::vector<T> sorted(items.size());
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (const T& x : items)
-      sorted[fill[key(x)[0]]++] = x;
-  }
-  for (std::size_t v = 0; v < n; ++v)
-    std::sort(sorted.begin() + start[v],
-              sorted.begin() + start[v + 1],
-              [&](const T& a, const T& b) { return key(a) < key(b); });
+  const std::vector<std::uint32_t> start = countingSort(
+      items.size(),
+      n,
+      threads,
+      [&](std::size_t i) { return key(items[i])[0]; },
+      [&](std::size_t i, std::uint32_t place) { sorted[place] = items[i]; });
+  const int parts = partsFor(items.size(), threads);
+  forEachPart(parts, [&](int part) {
+    for (std::size_t v = n * part / parts; v < n * (part + 1) / parts; ++v)
+      std::sort(sorted.begin() + start[v],
+                sorted.begin() + start[v + 1],
+                [&](const T& a, const T& b) { return key(a) < key(b); });
+  });
   items.swap(sorted);
 }
 

@@ -116,7 +116,7 @@ reconstruct(Triangulation& dt,
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
   detail::sortByVertexIds(
-      result.triangles, dt.points.size(), [](const Triangle& t) { return t; });
+      result.triangles, dt.points.size(), [](const Triangle& t) { return t; }, threads);
 
   // Normals: the pole line, turned to the side the mesh faces. At an undersampled
   // point the pole says little (at a border it leans towards the convex hull): there

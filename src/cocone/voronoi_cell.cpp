@@ -5,6 +5,7 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
+#include "edge_sort.h"
 #include "points.h"
 
 #include <algorithm>
@@ -483,9 +484,8 @@ computeCocones(const Triangulation& dt,
   for (std::size_t v = 0; v < n; ++v)
     if (!met[v])
       vc.width[v] = INF;
-  std::sort(vc.triangles.begin(),
-            vc.triangles.end(),
-            [](const CoconeTriangle& a, const CoconeTriangle& b) { return a.v < b.v; });
+  detail::sortByVertexIds(
+      vc.triangles, n, [](const CoconeTriangle& t) { return t.v; }, threads);
 }
 
 } // namespace cocone
