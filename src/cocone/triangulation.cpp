@@ -97,12 +97,38 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     keys.emplace_back(code, i);
   }
   std::vector<int>().swap(finite);
-  std::sort(keys.begin(), keys.end(), [&](const auto& a, const auto& b) {
-    if (a.first != b.first)
-      return a.first < b.first;
-    return lexLess(input[a.second], input[b.second]) ||
-           (input[a.second] == input[b.second] && a.second < b.second);
-  });
+  // By code: a stable radix sort, 16 bits a pass, keeps the input order within a
+  // code; the few runs of one code are then ordered by position.
+  {
+    constexpr int DIGIT = 16;
+    std::vector<std::pair<std::uint64_t, int>> buffer(keys.size());
+    std::vector<std::uint32_t> start(std::size_t(1) << DIGIT);
+    for (int shift = 0; shift < 64; shift += DIGIT) {
+      const auto digit = [&](const auto& key) {
+        return static_cast<std::size_t>((key.first >> shift) & ((1u << DIGIT) - 1));
+      };
+      std::fill(start.begin(), start.end(), 0);
+      for (const auto& key : keys)
+        ++start[digit(key)];
+      if (start[digit(keys.front())] == keys.size())
+        continue; // one digit for all
+      std::uint32_t total = 0;
+      for (auto& s : start)
+        total += std::exchange(s, total);
+      for (const auto& key : keys)
+        buffer[start[digit(key)]++] = key;
+      keys.swap(buffer);
+    }
+  }
+  for (std::size_t i = 0, j = 0; i < keys.size(); i = j) {
+    for (j = i + 1; j < keys.size() && keys[j].first == keys[i].first;)
+      ++j;
+    if (j - i > 1)
+      std::sort(keys.begin() + i, keys.begin() + j, [&](const auto& a, const auto& b) {
+        return lexLess(input[a.second], input[b.second]) ||
+               (input[a.second] == input[b.second] && a.second < b.second);
+      });
+  }
   for (const auto& key : keys) {
     const Eigen::Vector3d& p = input[key.second];
     if (out.points.empty() || out.points.back() != p)
