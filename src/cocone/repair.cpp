@@ -118,27 +118,33 @@ resolveVertices(std::vector<Triangle>& triangles,
   const auto considered = [&](int v) { return !only || (*only)[v]; };
   std::vector<int> fans;
   const std::vector<int> fan = vertexFans(list, num_vertices, &fans, threads);
+  touched.assign(num_vertices, 0);
+  const auto several = [&](int v) { return fans[v] > 1 && considered(v); };
+  bool any = false;
+  for (std::size_t v = 0; v < num_vertices && !any; ++v)
+    any = several(static_cast<int>(v));
+  if (!any)
+    return 0;
+  // The sizes of the fans of the vertices with several.
   std::vector<int> size_first(num_vertices + 1, 0);
   for (std::size_t v = 0; v < num_vertices; ++v)
-    size_first[v + 1] = size_first[v] + fans[v];
+    size_first[v + 1] = size_first[v] + (several(static_cast<int>(v)) ? fans[v] : 0);
   std::vector<int> size(size_first.back(), 0);
-  for (std::size_t c = 0; c < fan.size(); ++c)
-    ++size[size_first[list[c / 3][c % 3]] + fan[c]];
+  for (std::size_t c = 0; c < fan.size(); ++c) {
+    const int v = list[c / 3][c % 3];
+    if (size_first[v + 1] > size_first[v])
+      ++size[size_first[v] + fan[c]];
+  }
   std::vector<int> keep(num_vertices, 0);
-  bool any = false;
   for (std::size_t v = 0; v < num_vertices; ++v)
-    if (fans[v] > 1 && considered(static_cast<int>(v))) {
-      any = true;
+    if (size_first[v + 1] > size_first[v]) {
       const auto b = size.begin() + size_first[v];
       keep[v] = static_cast<int>(std::max_element(b, b + fans[v]) - b);
     }
-  touched.assign(num_vertices, 0);
-  if (!any)
-    return 0;
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   for (std::size_t c = 0; c < fan.size(); ++c) {
     const int v = list[c / 3][c % 3];
-    if (fans[v] > 1 && considered(v) && fan[c] != keep[v]) {
+    if (size_first[v + 1] > size_first[v] && fan[c] != keep[v]) {
       const std::size_t t = only ? subset[c / 3] : c / 3;
       drop[t] = 1;
       for (const int w : triangles[t])
@@ -306,7 +312,9 @@ orient(const std::vector<Eigen::Vector3d>& P,
     ++c;
   }
   // The same edges; the turned triangles run them the other way.
-  for (std::size_t i = 0; i < inc.triangle.size(); ++i)
+  const auto incidences = static_cast<std::ptrdiff_t>(inc.triangle.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+  for (std::ptrdiff_t i = 0; i < incidences; ++i)
     inc.forward[i] ^= turned_over[inc.triangle[i]];
   return compact(triangles, drop, &inc);
 }
