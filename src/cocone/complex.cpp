@@ -207,16 +207,5 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
   vertex_first_.assign(start.begin(), start.end());
 }
 
-int
-TriangleComplex::edgeOf(int t, int a, int b) const
-{
-  for (const int e : triangle_edges_[t]) {
-    const auto& ed = edges_[e];
-    if ((ed[0] == a && ed[1] == b) || (ed[0] == b && ed[1] == a))
-      return e;
-  }
-  return -1;
-}
-
 } // namespace cocone
 } // namespace pcl

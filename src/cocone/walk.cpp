@@ -18,17 +18,28 @@
 namespace pcl {
 namespace cocone {
 
+namespace {
+
+/** The edge of triangle t opposite its vertex z. */
 int
-surfaceNeighbor(const TriangleComplex& complex,
-                const std::vector<std::uint8_t>& present,
-                int t,
-                int x,
-                int y,
-                int z,
-                int& apex)
+edgeOpposite(const TriangleComplex& complex, int t, int z)
+{
+  const auto& v = complex.triangle(t);
+  return complex.triangleEdges(t)[v[0] == z ? 0 : v[1] == z ? 1 : 2];
+}
+
+/** surfaceNeighbor() across edge e (x y) of t. */
+int
+neighborAcross(const TriangleComplex& complex,
+               const std::vector<std::uint8_t>& present,
+               int t,
+               int e,
+               int x,
+               int y,
+               int z,
+               int& apex)
 {
   const auto& P = complex.points();
-  const int e = complex.edgeOf(t, x, y);
   // Frame of the edge: u in t's plane towards z, n along t's normal.
   const Eigen::Vector3d d = (P[y] - P[x]).normalized();
   Eigen::Vector3d u = P[z] - P[x];
@@ -58,6 +69,21 @@ surfaceNeighbor(const TriangleComplex& complex,
     }
   }
   return best;
+}
+
+} // namespace
+
+int
+surfaceNeighbor(const TriangleComplex& complex,
+                const std::vector<std::uint8_t>& present,
+                int t,
+                int x,
+                int y,
+                int z,
+                int& apex)
+{
+  return neighborAcross(
+      complex, present, t, edgeOpposite(complex, t, z), x, y, z, apex);
 }
 
 WalkResult
@@ -199,14 +225,14 @@ walk(const TriangleComplex& complex,
     while (!pending.empty()) {
       const Pending p = pending.back();
       pending.pop_back();
-      const int e = complex.edgeOf(p.t, p.x, p.y);
+      const auto& o = oriented[p.t];
+      const int z = o[0] + o[1] + o[2] - p.x - p.y;
+      const int e = edgeOpposite(complex, p.t, z);
       if (processed[e])
         continue;
       processed[e] = 1;
-      const auto& o = oriented[p.t];
-      const int z = o[0] + o[1] + o[2] - p.x - p.y;
       int a = -1;
-      const int t2 = surfaceNeighbor(complex, present, p.t, p.x, p.y, z, a);
+      const int t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
       if (t2 < 0)
         continue;
       const Triangle next{p.y, p.x, a};

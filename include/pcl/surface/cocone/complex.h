@@ -116,10 +116,6 @@ public:
     return vertex_triangles_[i];
   }
 
-  /** The edge of triangle t joining vertices a and b, -1 if none. */
-  int
-  edgeOf(int t, int a, int b) const;
-
   /** ISSHARP: edge e is sharp among the triangles for which alive(t) is true if it has
    * exactly one, or two consecutive ones (in circular order) with an angular gap of
    * more than 3 pi / 2 between them. No triangle: not sharp. */
