@@ -209,10 +209,10 @@ vertexFans(const std::vector<Triangle>& oriented,
         // A few triangles: compare every two, cheaper than sorting.
         for (int i = 1; i < size; ++i)
           for (int j = 0; j < i; ++j) {
-            const auto &a = others[2 * i], &b = others[2 * i + 1];
-            const auto &c = others[2 * j], &d = others[2 * j + 1];
-            if (a.first == c.first || a.first == d.first || b.first == c.first ||
-                b.first == d.first)
+            const auto* a = &others[2 * static_cast<std::size_t>(i)];
+            const auto* b = &others[2 * static_cast<std::size_t>(j)];
+            if (a[0].first == b[0].first || a[0].first == b[1].first ||
+                a[1].first == b[0].first || a[1].first == b[1].first)
               sets.unite(i, j);
           }
       }
