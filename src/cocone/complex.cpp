@@ -196,7 +196,7 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Vertex -> triangles, in ascending order.
   vertex_triangles_.resize(3 * m);
-  const std::vector<std::uint32_t> start = detail::sortCorners(
+  const std::vector<std::uint32_t> start = detail::groupCorners(
       triangles_,
       points_.size(),
       threads,

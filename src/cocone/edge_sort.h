@@ -9,9 +9,7 @@
 
 #include <pcl/surface/cocone/complex.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -37,33 +35,6 @@ incidenceCorner(std::uint64_t word)
   return static_cast<int>(word & 3u);
 }
 
-/** Run body(part) once for every part in [0, parts), on up to \a parts threads.
- * The body must not throw. */
-template <typename Body>
-void
-forEachPart(int parts, const Body& body)
-{
-#pragma omp parallel num_threads(parts)
-  {
-#ifdef _OPENMP
-    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int thread = 0, team = 1;
-#endif
-    for (int part = thread; part < parts; part += team)
-      body(part);
-  }
-}
-
-/** Parts for \a threads threads to split \a items into: some sixty thousand items a
- * part at least. */
-inline int
-partsFor(std::size_t items, int threads)
-{
-  return static_cast<int>(
-      std::clamp<std::size_t>(items / 65536, 1, static_cast<std::size_t>(threads)));
-}
-
 /** A stable counting sort of the items [0, count) by key(i), below \a buckets: calls
  * put(i, place) for every item, where the places of one key are together and in
  * ascending order of the items. With several threads, each counts and places a part
@@ -75,18 +46,14 @@ countingSort(
     std::size_t count, std::size_t buckets, int threads, const Key& key, const Put& put)
 {
   const int parts = partsFor(count, threads);
-  const auto range = [&](int part) {
-    return std::array<std::size_t, 2>{count * part / parts, count * (part + 1) / parts};
-  };
   // Per part and key: its count of items, then where the first of them goes (the
   // parts in order within a key).
   std::vector<std::vector<std::uint32_t>> place(parts);
   for (auto& p : place)
     p.resize(buckets);
-  forEachPart(parts, [&](int part) {
+  forEachRange(count, parts, [&](std::size_t begin, std::size_t end, int part) {
     auto& counted = place[part];
     std::fill(counted.begin(), counted.end(), 0);
-    const auto [begin, end] = range(part);
     for (std::size_t i = begin; i < end; ++i)
       ++counted[key(i)];
   });
@@ -101,9 +68,8 @@ countingSort(
     }
   }
   start[buckets] = total;
-  forEachPart(parts, [&](int part) {
+  forEachRange(count, parts, [&](std::size_t begin, std::size_t end, int part) {
     auto& next = place[part];
-    const auto [begin, end] = range(part);
     for (std::size_t i = begin; i < end; ++i)
       put(i, next[key(i)]++);
   });
@@ -115,11 +81,11 @@ countingSort(
  * \return per key b, where its corners begin; then the end (3 m) */
 template <typename Key, typename Put>
 std::vector<std::uint32_t>
-sortCorners(const std::vector<Triangle>& triangles,
-            std::size_t buckets,
-            int threads,
-            const Key& key,
-            const Put& put)
+groupCorners(const std::vector<Triangle>& triangles,
+             std::size_t buckets,
+             int threads,
+             const Key& key,
+             const Put& put)
 {
   return countingSort(
       3 * triangles.size(),
@@ -152,7 +118,7 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
     highest = std::max({highest, t[0], t[1], t[2]});
   const std::size_t buckets = static_cast<std::size_t>(highest) + 1;
   std::vector<std::uint64_t> word(3 * m);
-  const std::vector<std::uint32_t> start = sortCorners(
+  const std::vector<std::uint32_t> start = groupCorners(
       triangles,
       buckets,
       threads,
@@ -163,16 +129,11 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
       });
   const int parts = partsFor(3 * m, threads);
   // Sort the buckets of each part of the vertices, count its edges, then list them.
-  const auto vertex_range = [&](int part) {
-    return std::array<std::size_t, 2>{buckets * part / parts,
-                                      buckets * (part + 1) / parts};
-  };
   const auto opens_edge = [&](std::size_t v, std::size_t i) {
     return i == start[v] || word[i] >> 32 != word[i - 1] >> 32;
   };
   std::vector<std::size_t> edges_before(parts + 1, 0);
-  forEachPart(parts, [&](int part) {
-    const auto [begin, end] = vertex_range(part);
+  forEachRange(buckets, parts, [&](std::size_t begin, std::size_t end, int part) {
     std::size_t count = 0;
     for (std::size_t v = begin; v < end; ++v) {
       for (std::size_t i = start[v] + 1; i < start[v + 1]; ++i) {
@@ -190,8 +151,7 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
   std::partial_sum(edges_before.begin(), edges_before.end(), edges_before.begin());
   edges.resize(edges_before[parts]);
   first.resize(edges_before[parts] + 1);
-  forEachPart(parts, [&](int part) {
-    const auto [begin, end] = vertex_range(part);
+  forEachRange(buckets, parts, [&](std::size_t begin, std::size_t end, int part) {
     std::size_t e = edges_before[part];
     for (std::size_t v = begin; v < end; ++v)
       for (std::size_t i = start[v]; i < start[v + 1]; ++i)
@@ -220,13 +180,13 @@ sortByVertexIds(std::vector<T>& items, std::size_t n, const Key& key, int thread
       threads,
       [&](std::size_t i) { return key(items[i])[0]; },
       [&](std::size_t i, std::uint32_t place) { sorted[place] = items[i]; });
-  const int parts = partsFor(items.size(), threads);
-  forEachPart(parts, [&](int part) {
-    for (std::size_t v = n * part / parts; v < n * (part + 1) / parts; ++v)
-      std::sort(sorted.begin() + start[v],
-                sorted.begin() + start[v + 1],
-                [&](const T& a, const T& b) { return key(a) < key(b); });
-  });
+  forEachRange(
+      n, partsFor(items.size(), threads), [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t v = begin; v < end; ++v)
+          std::sort(sorted.begin() + start[v],
+                    sorted.begin() + start[v + 1],
+                    [&](const T& a, const T& b) { return key(a) < key(b); });
+      });
   items.swap(sorted);
 }
 

@@ -120,26 +120,27 @@ EdgeIncidences::add(const std::vector<Triangle>& oriented, std::size_t from)
   // Old edges [0, e) and their incidences [0, i) are still in their old places; the
   // merged ones from w and iw on are in their new places.
   std::size_t e = old_edges, i = old_incidences, w = edges.size(), iw = triangle.size();
-  // Move old edges [to, e) up to end at w. (first[e] may be a merged edge's already.)
-  const auto move_old = [&](std::size_t to) {
-    const std::size_t lists = to == e ? i : first[to];
-    const std::size_t shift = iw - i;
+  // Move the old incidences [from, i) up to end at iw.
+  const auto lift = [&](std::size_t from) {
     std::move_backward(
-        triangle.begin() + lists, triangle.begin() + i, triangle.begin() + iw);
+        triangle.begin() + from, triangle.begin() + i, triangle.begin() + iw);
     std::move_backward(
-        forward.begin() + lists, forward.begin() + i, forward.begin() + iw);
+        forward.begin() + from, forward.begin() + i, forward.begin() + iw);
+    iw -= i - from;
+    i = from;
+  };
+  first.back() = triangle.size();
+  for (std::size_t a = added.edges.size(); a-- > 0;) {
+    // The old edges after this one, up to end at w. (first[e] may be a merged
+    // edge's already.)
+    const std::size_t to = before[a] + twin[a], shift = iw - i;
+    lift(to == e ? i : first[to]);
     for (std::size_t k = e; k-- > to;) {
       --w;
       edges[w] = edges[k];
       first[w] = first[k] + shift;
     }
-    iw -= i - lists;
-    i = lists;
     e = to;
-  };
-  first.back() = triangle.size();
-  for (std::size_t a = added.edges.size(); a-- > 0;) {
-    move_old(before[a] + twin[a]);
     // The new incidences of the edge, after its old ones if it had any.
     const std::size_t begin = added.first[a], end = added.first[a + 1];
     iw -= end - begin;
@@ -149,16 +150,8 @@ EdgeIncidences::add(const std::vector<Triangle>& oriented, std::size_t from)
     std::copy(added.forward.begin() + begin,
               added.forward.begin() + end,
               forward.begin() + iw);
-    if (twin[a]) {
-      const std::size_t lists = first[e - 1];
-      std::move_backward(
-          triangle.begin() + lists, triangle.begin() + i, triangle.begin() + iw);
-      std::move_backward(
-          forward.begin() + lists, forward.begin() + i, forward.begin() + iw);
-      iw -= i - lists;
-      i = lists;
-      --e;
-    }
+    if (twin[a])
+      lift(first[--e]);
     --w;
     edges[w] = added.edges[a];
     first[w] = iw;
@@ -175,7 +168,7 @@ vertexFans(const std::vector<Triangle>& oriented,
   // triangles share an edge at the vertex.
   const std::size_t m = oriented.size();
   std::vector<int> corners(3 * m);
-  const std::vector<std::uint32_t> corner_first = detail::sortCorners(
+  const std::vector<std::uint32_t> corner_first = detail::groupCorners(
       oriented,
       num_vertices,
       threads,

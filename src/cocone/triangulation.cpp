@@ -10,6 +10,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include "delaunay.h"
+#include "parallel.h"
 #include "points.h"
 #ifdef _OPENMP
 #include <omp.h>
@@ -257,33 +258,6 @@ triangulatePlanar(const std::vector<Eigen::Vector3d>& points, detail::BuildCells
   }
 }
 
-/** Run body(first, end, thread) over the finite cells, split in equal runs per
- * thread. */
-template <typename Body>
-void
-splitCells(std::size_t count, int threads, const Body& body)
-{
-  // An exception must not leave a parallel region: it is caught in the thread and
-  // thrown again after the region (only std::bad_alloc can occur here).
-  bool failed = false;
-#pragma omp parallel num_threads(threads)
-  {
-#ifdef _OPENMP
-    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int thread = 0, team = 1;
-#endif
-    try {
-      body(count * thread / team, count * (thread + 1) / team, thread);
-    }
-    catch (const std::bad_alloc&) {
-      __atomic_store_n(&failed, true, __ATOMIC_RELAXED);
-    }
-  }
-  if (failed)
-    throw std::bad_alloc();
-}
-
 /** Keep the cells in the order the passes visit them: the finite cells by smallest
  * vertex id, in buckets of 64 ids (a counting sort with few write positions; inside
  * a bucket the builder's order, which does not matter), then the infinite ones. In
@@ -304,20 +278,21 @@ orderCells(const detail::BuildCells& built,
   std::vector<std::vector<std::uint32_t>> start(threads);
   // Per built cell its bucket, then its place.
   std::vector<int> slot(built.size());
-  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
-    start[t].assign(infinite + 1, 0);
-    for (std::size_t c = begin; c < end; ++c) {
-      const auto& v = built[c].v;
-      slot[c] = FREE;
-      if (v[0] == detail::BuildCell::FREE)
-        continue;
-      int lowest = v[0];
-      for (int i = 1; i < corners; ++i)
-        lowest = (lowest < 0 || v[i] < 0) ? -1 : std::min(lowest, v[i]);
-      slot[c] = lowest < 0 ? infinite : lowest >> BUCKET_BITS;
-      ++start[t][slot[c]];
-    }
-  });
+  detail::forEachRange(
+      built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
+        start[t].assign(infinite + 1, 0);
+        for (std::size_t c = begin; c < end; ++c) {
+          const auto& v = built[c].v;
+          slot[c] = FREE;
+          if (v[0] == detail::BuildCell::FREE)
+            continue;
+          int lowest = v[0];
+          for (int i = 1; i < corners; ++i)
+            lowest = (lowest < 0 || v[i] < 0) ? -1 : std::min(lowest, v[i]);
+          slot[c] = lowest < 0 ? infinite : lowest >> BUCKET_BITS;
+          ++start[t][slot[c]];
+        }
+      });
   std::uint32_t total = 0;
   for (int b = 0; b <= infinite; ++b) {
     if (b == infinite)
@@ -331,22 +306,24 @@ orderCells(const detail::BuildCells& built,
   // Sized without being written: the pages are first touched by the threads below.
   out.vertices.resize(total);
   out.neighbors.resize(total);
-  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
-    for (std::size_t c = begin; c < end; ++c)
-      if (slot[c] != FREE)
-        slot[c] = static_cast<int>(start[t][slot[c]]++);
-  });
-  splitCells(built.size(), threads, [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t c = begin; c < end; ++c) {
-      if (slot[c] == FREE)
-        continue;
-      auto& v = out.vertices[slot[c]];
-      auto& n = out.neighbors[slot[c]];
-      v = built[c].v;
-      for (int i = 0; i < 4; ++i)
-        n[i] = i < corners ? slot[built[c].n[i] >> 2] : -1;
-    }
-  });
+  detail::forEachRange(
+      built.size(), threads, [&](std::size_t begin, std::size_t end, int t) {
+        for (std::size_t c = begin; c < end; ++c)
+          if (slot[c] != FREE)
+            slot[c] = static_cast<int>(start[t][slot[c]]++);
+      });
+  detail::forEachRange(
+      built.size(), threads, [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t c = begin; c < end; ++c) {
+          if (slot[c] == FREE)
+            continue;
+          auto& v = out.vertices[slot[c]];
+          auto& n = out.neighbors[slot[c]];
+          v = built[c].v;
+          for (int i = 0; i < 4; ++i)
+            n[i] = i < corners ? slot[built[c].n[i] >> 2] : -1;
+        }
+      });
 }
 
 /** Number of the cells' corners: 4, or 3 when the triangulation is planar. */
@@ -368,7 +345,7 @@ computeCircumcenters(const Triangulation& dt, int threads)
   s.build.reserve(circumcenterCells(s.finite));
   s.circumcenters = reinterpret_cast<Eigen::Vector3d*>(s.build.data());
   std::uninitialized_default_construct_n(s.circumcenters, s.finite);
-  splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
+  detail::forEachRange(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t k = begin; k < end; ++k) {
       std::array<int, 4> v = s.vertices[k];
       detail::sortCorners(v, corners, [](int id) { return id; });
@@ -489,49 +466,50 @@ visitCells(const Triangulation& dt,
   if (((data & CellView::CIRCUMCENTER) || neighbors) && !s.circumcenters)
     computeCircumcenters(dt, threads);
   const int finite = static_cast<int>(s.finite);
-  splitCells(s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
-    constexpr std::size_t AHEAD = 8;
-    CellView view;
-    view.corners = corners;
-    for (std::size_t k = begin; k < end; ++k) {
-      const int c = static_cast<int>(k);
-      const auto& across = s.neighbors[k];
-      view.v = s.vertices[k];
-      view.ahead = {-1, -1, -1, -1};
-      if (k + AHEAD < end) {
-        view.ahead = s.vertices[k + AHEAD];
-        if (neighbors)
-          for (int i = 0; i < corners; ++i) {
-            const int other = s.neighbors[k + AHEAD][i];
-            if (other < finite)
-              __builtin_prefetch(&s.circumcenters[other]);
+  detail::forEachRange(
+      s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
+        constexpr std::size_t AHEAD = 8;
+        CellView view;
+        view.corners = corners;
+        for (std::size_t k = begin; k < end; ++k) {
+          const int c = static_cast<int>(k);
+          const auto& across = s.neighbors[k];
+          view.v = s.vertices[k];
+          view.ahead = {-1, -1, -1, -1};
+          if (k + AHEAD < end) {
+            view.ahead = s.vertices[k + AHEAD];
+            if (neighbors)
+              for (int i = 0; i < corners; ++i) {
+                const int other = s.neighbors[k + AHEAD][i];
+                if (other < finite)
+                  __builtin_prefetch(&s.circumcenters[other]);
+              }
           }
-      }
-      if (data & CellView::CIRCUMCENTER)
-        view.circumcenter = s.circumcenters[k];
-      view.edges = 0;
-      // The neighbours about an edge lie across the facets opposite the other two
-      // vertices.
-      for (int e = 0; (data & CellView::EDGES) && corners == 4 && e < 6; ++e) {
-        const auto& ends = CellView::EDGE_ENDS[5 - e];
-        if (c < across[ends[0]] && c < across[ends[1]])
-          view.edges |= static_cast<std::uint8_t>(1u << e);
-      }
-      for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
-        // Each interior facet once: from the cell visited later.
-        if (i >= corners || across[i] >= finite)
-          view.facet[i] = FacetRole::HULL;
-        else if (across[i] > c)
-          view.facet[i] = FacetRole::SHARED;
-        else {
-          view.facet[i] = FacetRole::OWN;
-          if (neighbors)
-            view.neighbor_circumcenter[i] = s.circumcenters[across[i]];
+          if (data & CellView::CIRCUMCENTER)
+            view.circumcenter = s.circumcenters[k];
+          view.edges = 0;
+          // The neighbours about an edge lie across the facets opposite the other two
+          // vertices.
+          for (int e = 0; (data & CellView::EDGES) && corners == 4 && e < 6; ++e) {
+            const auto& ends = CellView::EDGE_ENDS[5 - e];
+            if (c < across[ends[0]] && c < across[ends[1]])
+              view.edges |= static_cast<std::uint8_t>(1u << e);
+          }
+          for (int i = 0; (data & CellView::FACETS) && i < 4; ++i) {
+            // Each interior facet once: from the cell visited later.
+            if (i >= corners || across[i] >= finite)
+              view.facet[i] = FacetRole::HULL;
+            else if (across[i] > c)
+              view.facet[i] = FacetRole::SHARED;
+            else {
+              view.facet[i] = FacetRole::OWN;
+              if (neighbors)
+                view.neighbor_circumcenter[i] = s.circumcenters[across[i]];
+            }
+          }
+          visitor(context, view, thread);
         }
-      }
-      visitor(context, view, thread);
-    }
-  });
+      });
 }
 
 } // namespace detail

@@ -266,21 +266,17 @@ walkedIncidences(const TriangleComplex& complex, const WalkResult& walked, int t
   // then filled in; at an edge in the order of the walk's triangles.
   const std::size_t num_edges = complex.numEdges();
   const int parts = detail::partsFor(num_edges, threads);
-  const auto range = [&](int part) {
-    return std::array<std::size_t, 2>{num_edges * part / parts,
-                                      num_edges * (part + 1) / parts};
-  };
   std::vector<std::size_t> edges_before(parts + 1, 0), incidences_before(parts + 1, 0);
-  detail::forEachPart(parts, [&](int part) {
-    const auto [begin, end] = range(part);
-    for (std::size_t e = begin; e < end; ++e) {
-      std::size_t here = 0;
-      for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i)
-        here += index[complex.edgeTriangle(i)] >= 0;
-      edges_before[part + 1] += here > 0;
-      incidences_before[part + 1] += here;
-    }
-  });
+  detail::forEachRange(
+      num_edges, parts, [&](std::size_t begin, std::size_t end, int part) {
+        for (std::size_t e = begin; e < end; ++e) {
+          std::size_t here = 0;
+          for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i)
+            here += index[complex.edgeTriangle(i)] >= 0;
+          edges_before[part + 1] += here > 0;
+          incidences_before[part + 1] += here;
+        }
+      });
   std::partial_sum(edges_before.begin(), edges_before.end(), edges_before.begin());
   std::partial_sum(
       incidences_before.begin(), incidences_before.end(), incidences_before.begin());
@@ -289,33 +285,33 @@ walkedIncidences(const TriangleComplex& complex, const WalkResult& walked, int t
   out.first.resize(edges_before[parts] + 1);
   out.triangle.resize(incidences_before[parts]);
   out.forward.resize(incidences_before[parts]);
-  detail::forEachPart(parts, [&](int part) {
-    const auto [begin, end] = range(part);
-    std::size_t w = edges_before[part], iw = incidences_before[part];
-    for (std::size_t e = begin; e < end; ++e) {
-      const std::size_t from = iw;
-      for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
-        const int t = index[complex.edgeTriangle(i)];
-        if (t < 0)
-          continue;
-        std::size_t j = iw++;
-        for (; j > from && out.triangle[j - 1] > t; --j)
-          out.triangle[j] = out.triangle[j - 1];
-        out.triangle[j] = t;
-      }
-      if (iw == from)
-        continue;
-      const auto& edge = complex.edge(static_cast<int>(e));
-      for (std::size_t i = from; i < iw; ++i) {
-        const Triangle& v = walked.triangles[out.triangle[i]];
-        out.forward[i] = (v[0] == edge[0] && v[1] == edge[1]) ||
-                         (v[1] == edge[0] && v[2] == edge[1]) ||
-                         (v[2] == edge[0] && v[0] == edge[1]);
-      }
-      out.edges[w] = edge;
-      out.first[w++] = from;
-    }
-  });
+  detail::forEachRange(
+      num_edges, parts, [&](std::size_t begin, std::size_t end, int part) {
+        std::size_t w = edges_before[part], iw = incidences_before[part];
+        for (std::size_t e = begin; e < end; ++e) {
+          const std::size_t from = iw;
+          for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+            const int t = index[complex.edgeTriangle(i)];
+            if (t < 0)
+              continue;
+            std::size_t j = iw++;
+            for (; j > from && out.triangle[j - 1] > t; --j)
+              out.triangle[j] = out.triangle[j - 1];
+            out.triangle[j] = t;
+          }
+          if (iw == from)
+            continue;
+          const auto& edge = complex.edge(static_cast<int>(e));
+          for (std::size_t i = from; i < iw; ++i) {
+            const Triangle& v = walked.triangles[out.triangle[i]];
+            out.forward[i] = (v[0] == edge[0] && v[1] == edge[1]) ||
+                             (v[1] == edge[0] && v[2] == edge[1]) ||
+                             (v[2] == edge[0] && v[0] == edge[1]);
+          }
+          out.edges[w] = edge;
+          out.first[w++] = from;
+        }
+      });
   out.first.back() = out.triangle.size();
   return out;
 }
