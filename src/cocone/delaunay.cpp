@@ -784,7 +784,11 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
     points.emplace_back(p.x(), p.y(), p.z());
 
   // CGAL's insertion order: its spatial sort (a Hilbert curve over random rounds
-  // of growing size, seeded), which keeps every walk short.
+  // of growing size, seeded), which keeps every walk short. Its 3D defaults, spelled
+  // out because the rounds are cut into stretches below: a round is the last eighth
+  // (ROUND_RATIO) of what is left, down to 64 points (ROUND_FROM).
+  constexpr double ROUND_RATIO = 0.125;
+  constexpr int ROUND_FROM = 64;
   std::vector<int> order(n);
   {
     std::vector<std::pair<Point, int>> sites;
@@ -795,7 +799,11 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
                        sites.end(),
                        CGAL::Spatial_sort_traits_adapter_3<
                            Kernel,
-                           CGAL::First_of_pair_property_map<std::pair<Point, int>>>());
+                           CGAL::First_of_pair_property_map<std::pair<Point, int>>>(),
+                       CGAL::Hilbert_sort_median_policy(),
+                       std::ptrdiff_t(0), // CGAL's default curve resolution
+                       std::ptrdiff_t(ROUND_FROM),
+                       ROUND_RATIO);
     for (int i = 0; i < n; ++i)
       order[i] = sites[i].second;
   }
@@ -818,13 +826,13 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   if (fourth < 0)
     return 2;
 
-  // The points left to insert, and where CGAL's rounds begin among them: in 3D its
-  // multiscale sort sorts the first twentieth of the points (from 500 on) the same
-  // way before it, and the rest along one Hilbert curve; a round long enough is cut
-  // below into a stretch of its curve per thread.
+  // The points left to insert, and where CGAL's rounds begin among them: its
+  // multiscale sort sorts the first eighth of the points (from 64 on) the same way
+  // before it, and the rest along one Hilbert curve; a round long enough is cut below
+  // into a stretch of its curve per thread.
   std::vector<int> round_end{n};
-  while (round_end.back() > 500)
-    round_end.push_back(static_cast<int>(double(round_end.back()) * 0.05));
+  while (round_end.back() >= ROUND_FROM)
+    round_end.push_back(static_cast<int>(double(round_end.back()) * ROUND_RATIO));
   std::reverse(round_end.begin(), round_end.end());
   std::vector<int> rest;
   rest.reserve(input.size());

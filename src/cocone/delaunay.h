@@ -84,7 +84,7 @@ infiniteCorner(const std::array<int, 4>& v)
  * perturbation. Kept in two 16-byte arrays per cell instead of CGAL's linked cells,
  * which halves its memory and lets the passes read cells by index.
  *
- * With several threads, the points after the first twentieth (CGAL's last round,
+ * With several threads, the points after the first eighth (CGAL's last round,
  * along one Hilbert curve) are cut into one stretch of the curve per thread, a part
  * of space each, and inserted at once; a thread holds every cell it reads, and an
  * insertion that meets a cell held by another thread is left for the end, when one
