@@ -165,34 +165,19 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
       edge_triangles_[i] = t;
     }
 
-  // Angles about each edge of more than two triangles in a frame of the edge; at an
-  // edge of two, the sign of the dot product of their directions from the edge
-  // (orthogonal to it) tells whether they make an angle below pi / 2.
-  edge_angles_.resize(word.size());
+  // At an edge of two triangles, the sign of the dot product of their directions
+  // from the edge (orthogonal to it) tells whether they make an angle below pi / 2.
+  // (The rare edges of more than two compute their angles when asked.)
   acute_pair_.assign(edges_.size(), 0);
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
-  for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
-    const Eigen::Vector3d& a = points_[edges_[e][0]];
-    const auto apex = [&](std::size_t i) {
-      const auto& v = triangles_[edge_triangles_[i]];
-      return points_[v[0] + v[1] + v[2] - edges_[e][0] - edges_[e][1]] - a;
-    };
+  for (std::ptrdiff_t e = 0; e < num_edges; ++e)
     if (edge_first_[e + 1] - edge_first_[e] == 2) {
+      const Eigen::Vector3d& a = points_[edges_[e][0]];
       const Eigen::Vector3d d = points_[edges_[e][1]] - a;
-      const Eigen::Vector3d u = apex(edge_first_[e]), w = apex(edge_first_[e] + 1);
+      const Eigen::Vector3d u = apexFrom(static_cast<int>(e), edge_first_[e]),
+                            w = apexFrom(static_cast<int>(e), edge_first_[e] + 1);
       acute_pair_[e] = u.dot(w) * d.squaredNorm() > u.dot(d) * w.dot(d);
-      continue;
     }
-    const Eigen::Vector3d d = (points_[edges_[e][1]] - a).normalized();
-    int axis = 0;
-    d.cwiseAbs().minCoeff(&axis);
-    const Eigen::Vector3d x = d.cross(Eigen::Vector3d::Unit(axis)).normalized();
-    const Eigen::Vector3d y = d.cross(x);
-    for (std::size_t i = edge_first_[e]; i < edge_first_[e + 1]; ++i) {
-      const Eigen::Vector3d w = apex(i);
-      edge_angles_[i] = std::atan2(w.dot(y), w.dot(x));
-    }
-  }
 
   // Vertex -> triangles, in ascending order.
   vertex_triangles_.resize(3 * m);
@@ -205,6 +190,30 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
         vertex_triangles_[place] = static_cast<int>(t);
       });
   vertex_first_.assign(start.begin(), start.end());
+}
+
+Eigen::Vector3d
+TriangleComplex::apexFrom(int e, std::size_t i) const
+{
+  const auto& v = triangles_[edge_triangles_[i]];
+  return points_[v[0] + v[1] + v[2] - edges_[e][0] - edges_[e][1]] -
+         points_[edges_[e][0]];
+}
+
+void
+TriangleComplex::edgeAngles(int e, std::vector<double>& angles) const
+{
+  const Eigen::Vector3d d =
+      (points_[edges_[e][1]] - points_[edges_[e][0]]).normalized();
+  int axis = 0;
+  d.cwiseAbs().minCoeff(&axis);
+  const Eigen::Vector3d x = d.cross(Eigen::Vector3d::Unit(axis)).normalized();
+  const Eigen::Vector3d y = d.cross(x);
+  angles.clear();
+  for (std::size_t i = edgeBegin(e); i < edgeEnd(e); ++i) {
+    const Eigen::Vector3d w = apexFrom(e, i);
+    angles.push_back(std::atan2(w.dot(y), w.dot(x)));
+  }
 }
 
 } // namespace cocone

@@ -19,9 +19,9 @@ using Triangle = std::array<int, 3>;
 /** \brief A triangle complex with its edges and incidences, as flat arrays.
  *
  * Stages 5-7 (umbrella check, pruning, walk) work on the candidate triangles
- * through this structure. At an edge of more than two triangles each carries its
- * angle about the edge, which gives their circular order; of an edge of two, whether
- * they make an angle below pi / 2 is kept.
+ * through this structure. Of an edge of two triangles, whether they make an angle
+ * below pi / 2 is kept; at the rare edges of more, their angles about the edge, which
+ * give their circular order, are computed when ISSHARP asks.
  */
 class TriangleComplex {
 public:
@@ -124,15 +124,21 @@ public:
   isSharp(int e, const Alive& alive) const;
 
 private:
+  /** The apex of the triangle of incidence i of edge e, from the edge's first end. */
+  Eigen::Vector3d
+  apexFrom(int e, std::size_t i) const;
+
+  /** The angles about edge e, in [-pi, pi] in a frame of the edge, of its
+   * incidences in order. */
+  void
+  edgeAngles(int e, std::vector<double>& angles) const;
+
   const std::vector<Eigen::Vector3d>& points_;
   std::vector<Triangle> triangles_;
   std::vector<std::array<int, 3>> triangle_edges_;
   std::vector<std::array<int, 2>> edges_;
   std::vector<std::size_t> edge_first_;
   std::vector<int> edge_triangles_;
-  /** Per incidence of an edge of more than two triangles: its angle about the edge,
-   * in [-pi, pi]. */
-  std::vector<double> edge_angles_;
   /** Per edge of two triangles: they make an angle below pi / 2. */
   std::vector<std::uint8_t> acute_pair_;
   std::vector<std::size_t> vertex_first_;
@@ -160,11 +166,12 @@ TriangleComplex::isSharp(int e, const Alive& alive) const
     const bool a = alive(edge_triangles_[first]), b = alive(edge_triangles_[first + 1]);
     return a != b || (a && acute_pair_[e]);
   }
-  thread_local std::vector<double> angles;
+  thread_local std::vector<double> all, angles;
+  edgeAngles(e, all);
   angles.clear();
   for (std::size_t i = first; i < edgeEnd(e); ++i)
     if (alive(edge_triangles_[i]))
-      angles.push_back(edge_angles_[i]);
+      angles.push_back(all[i - first]);
   if (angles.empty())
     return false;
   if (angles.size() == 1)
