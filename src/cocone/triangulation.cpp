@@ -10,6 +10,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include "delaunay.h"
+#include "edge_sort.h"
 #include "parallel.h"
 #include "points.h"
 #ifdef _OPENMP
@@ -98,26 +99,21 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     keys.emplace_back(code, i);
   }
   std::vector<int>().swap(finite);
-  // By code: a stable radix sort, 16 bits a pass, keeps the input order within a
-  // code; the few runs of one code are then ordered by position.
+  // By code: a radix sort, one stable counting sort a 16-bit digit, keeps the input
+  // order within a code; the few runs of one code are then ordered by position.
   {
     constexpr int DIGIT = 16;
     std::vector<std::pair<std::uint64_t, int>> buffer(keys.size());
-    std::vector<std::uint32_t> start(std::size_t(1) << DIGIT);
     for (int shift = 0; shift < 64; shift += DIGIT) {
-      const auto digit = [&](const auto& key) {
-        return static_cast<std::size_t>((key.first >> shift) & ((1u << DIGIT) - 1));
-      };
-      std::fill(start.begin(), start.end(), 0);
-      for (const auto& key : keys)
-        ++start[digit(key)];
-      if (start[digit(keys.front())] == keys.size())
-        continue; // one digit for all
-      std::uint32_t total = 0;
-      for (auto& s : start)
-        total += std::exchange(s, total);
-      for (const auto& key : keys)
-        buffer[start[digit(key)]++] = key;
+      detail::countingSort(
+          keys.size(),
+          std::size_t(1) << DIGIT,
+          1,
+          [&](std::size_t j) {
+            return static_cast<std::size_t>((keys[j].first >> shift) &
+                                            ((1u << DIGIT) - 1));
+          },
+          [&](std::size_t j, std::uint32_t place) { buffer[place] = keys[j]; });
       keys.swap(buffer);
     }
   }
