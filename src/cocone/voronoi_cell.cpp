@@ -397,6 +397,7 @@ computeCocones(const Triangulation& dt,
   // atomic updates and each thread collects its triangles; the sort below fixes
   // their order.
   const double cos_angle = std::cos(cocone_angle);
+  const double c2 = cos_angle * cos_angle;
   // The squared distance to v- and the width are raised in place.
   std::vector<double>& neg2 = vc.height_minus;
   std::vector<double>& width = vc.width;
@@ -425,19 +426,57 @@ computeCocones(const Triangulation& dt,
                     __builtin_prefetch(&neg2[a]);
                     __builtin_prefetch(&width[a]);
                   }
+                // Per corner: where the Voronoi vertex lies from it, along its pole
+                // (s) and off its co-cone (q > 0: in one nappe of the double cone
+                // around the pole line, the co-cone's complement). A candidate for
+                // the negative pole, and one end of the Voronoi edges of the
+                // corner's facets.
                 const Eigen::Vector3d& cc = cell.circumcenter;
-                if (isFinite(cc))
-                  for (const int v : cell.v) {
+                const bool finite = isFinite(cc);
+                std::array<double, 4> s{}, q{};
+                if (finite)
+                  for (int j = 0; j < 4; ++j) {
+                    const int v = cell.v[j];
                     const Eigen::Vector3d y = cc - P[v];
-                    if (y.dot(vc.pole[v]) < 0.0)
-                      atomicMax(&neg2[v], y.squaredNorm());
+                    s[j] = y.dot(vc.pole[v]);
+                    const double yy = y.squaredNorm();
+                    if (s[j] < 0.0)
+                      atomicMax(&neg2[v], yy);
+                    q[j] = s[j] * s[j] - c2 * yy;
                   }
                 for (int i = 0; i < 4; ++i) {
                   if (cell.facet[i] == FacetRole::SHARED)
                     continue;
+                  const bool ray = cell.facet[i] == FacetRole::HULL;
+                  // Most Voronoi edges have both ends in one nappe of each of their
+                  // corners' double cones, which is convex: they miss the co-cones.
+                  // intersectCocone rejects them so too, but only after setting up
+                  // the edge; here the ends' values above decide (the same bits at
+                  // the edge's first end, its far end read directly instead of off
+                  // the expanded quadratic). The corners left get the whole test.
+                  unsigned test = 0;
+                  for (int j = 0; j < 4; ++j)
+                    if (j != i)
+                      test |= 1u << j;
+                  const Eigen::Vector3d& other = cell.neighbor_circumcenter[i];
+                  if (!ray) {
+                    if (!finite || !isFinite(other))
+                      continue;
+                    for (int j = 0; j < 4; ++j) {
+                      if (j == i || !(q[j] > 0.0))
+                        continue;
+                      const int v = cell.v[j];
+                      const Eigen::Vector3d y = other - P[v];
+                      const double sy = y.dot(vc.pole[v]);
+                      if (sy * sy - c2 * y.squaredNorm() > 0.0 &&
+                          (sy > 0.0) == (s[j] > 0.0))
+                        test &= ~(1u << j);
+                    }
+                    if (!test)
+                      continue;
+                  }
                   const auto f = detail::oppositeFacet(cell.v, i).ids;
                   Eigen::Vector3d a = cc, d;
-                  const bool ray = cell.facet[i] == FacetRole::HULL;
                   if (ray) {
                     d = outwardNormal(P, f, cell.outwardSide(i));
                     // An unbounded Voronoi edge going to the negative side puts
@@ -449,7 +488,7 @@ computeCocones(const Triangulation& dt,
                   else {
                     // Orient the segment canonically so the test is bitwise
                     // reproducible.
-                    Eigen::Vector3d b = cell.neighbor_circumcenter[i];
+                    Eigen::Vector3d b = other;
                     if (lexLess(b, a))
                       std::swap(a, b);
                     d = b - a;
@@ -459,6 +498,11 @@ computeCocones(const Triangulation& dt,
                   std::uint8_t meets = 0;
                   for (int k = 0; k < 3; ++k) {
                     const int v = f[k];
+                    int j = 0;
+                    while (cell.v[j] != v)
+                      ++j;
+                    if (!(test >> j & 1u))
+                      continue;
                     const CoconeHit hit =
                         intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
                     if (hit.meets) {
