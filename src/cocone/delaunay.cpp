@@ -5,9 +5,16 @@
 
 #include "delaunay.h"
 
+#include <boost/random/linear_congruential.hpp>
+#include <boost/random/random_number_generator.hpp>
+
+#include <CGAL/algorithm.h>
+#include <CGAL/Hilbert_sort_median_3.h>
+#include <CGAL/Multiscale_sort.h>
 #include <CGAL/property_map.h>
-#include <CGAL/spatial_sort.h>
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
+
+#include "parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -693,6 +700,92 @@ private:
   std::size_t next_ = 0, end_ = 0;
 };
 
+using Site = std::pair<Point, int>;
+using SiteTraits =
+    CGAL::Spatial_sort_traits_adapter_3<Kernel, CGAL::First_of_pair_property_map<Site>>;
+using SiteIterator = std::vector<Site>::iterator;
+
+/** CGAL's median Hilbert sort (its 3D spatial sort's curve, the same order), with
+ * its eight octants' curves sorted by up to \a threads threads: the first three
+ * levels of its median splits here, the rest by its own recursion on each octant. */
+class HilbertSort {
+public:
+  HilbertSort(int threads) : threads_(threads) {}
+
+  void
+  operator()(SiteIterator begin, SiteIterator end) const
+  {
+    // Threads pay once each octant holds some ten thousand points.
+    if (threads_ < 2 || end - begin < 80000) {
+      curve_.recursive_sort<0, false, false, false>(begin, end);
+      return;
+    }
+    // The curve's first level: halves in x, quarters in y (the second one turned),
+    // eighths in z, as CGAL splits them (nth_element at the middle).
+    std::array<SiteIterator, 9> m;
+    m[0] = begin;
+    m[8] = end;
+    m[4] = split(m[0], m[8], 0, false);
+    detail::forEachRange(
+        2, std::min(threads_, 2), [&](std::size_t b, std::size_t e, int) {
+          for (std::size_t k = b; k < e; ++k)
+            m[2 + 4 * k] = split(m[4 * k], m[4 * k + 4], 1, k == 1);
+        });
+    detail::forEachRange(
+        4, std::min(threads_, 4), [&](std::size_t b, std::size_t e, int) {
+          for (std::size_t k = b; k < e; ++k)
+            m[1 + 2 * k] = split(m[2 * k], m[2 * k + 2], 2, k % 2 == 1);
+        });
+    detail::forEachRange(
+        8, std::min(threads_, 8), [&](std::size_t b, std::size_t e, int) {
+          for (std::size_t k = b; k < e; ++k)
+            octant(static_cast<int>(k), m[k], m[k + 1]);
+        });
+  }
+
+private:
+  /** CGAL's curve below its first level, in octant k: the axis it splits first and
+   * the directions along each, as its recursion passes them down. */
+  void
+  octant(int k, SiteIterator b, SiteIterator e) const
+  {
+    switch (k) {
+    case 0:
+      return curve_.recursive_sort<2, false, false, false>(b, e);
+    case 1:
+    case 2:
+      return curve_.recursive_sort<1, false, false, false>(b, e);
+    case 3:
+    case 4:
+      return curve_.recursive_sort<0, false, true, true>(b, e);
+    case 5:
+    case 6:
+      return curve_.recursive_sort<1, true, false, true>(b, e);
+    default:
+      return curve_.recursive_sort<2, true, true, false>(b, e);
+    }
+  }
+
+  /** The middle of [b, e) along \a axis, ascending or (\a up) descending, and the
+   * range split around it. */
+  static SiteIterator
+  split(SiteIterator b, SiteIterator e, int axis, bool up)
+  {
+    if (b >= e)
+      return b;
+    const SiteIterator middle = b + (e - b) / 2;
+    std::nth_element(b, middle, e, [axis, up](const Site& p, const Site& q) {
+      const double a = p.first[axis], c = q.first[axis];
+      return up ? c < a : a < c;
+    });
+    return middle;
+  }
+
+  /** CGAL's default: ranges of up to 8 points are left as they are. */
+  CGAL::Hilbert_sort_median_3<SiteTraits, CGAL::Sequential_tag> curve_{SiteTraits(), 8};
+  int threads_;
+};
+
 /** Insert rest[lo, hi), one round of the spatial sort, with up to \a threads
  * builders (\a main is the first), a stretch of the round each. */
 void
@@ -791,19 +884,17 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   constexpr int ROUND_FROM = 64;
   std::vector<int> order(n);
   {
-    std::vector<std::pair<Point, int>> sites;
+    std::vector<Site> sites;
     sites.reserve(input.size());
     for (int i = 0; i < n; ++i)
       sites.emplace_back(points[i], i);
-    CGAL::spatial_sort(sites.begin(),
-                       sites.end(),
-                       CGAL::Spatial_sort_traits_adapter_3<
-                           Kernel,
-                           CGAL::First_of_pair_property_map<std::pair<Point, int>>>(),
-                       CGAL::Hilbert_sort_median_policy(),
-                       std::ptrdiff_t(0), // CGAL's default curve resolution
-                       std::ptrdiff_t(ROUND_FROM),
-                       ROUND_RATIO);
+    // CGAL::spatial_sort's steps: its seeded shuffle, then its rounds, each along
+    // its Hilbert curve (here with threads on a long round).
+    boost::rand48 random;
+    boost::random_number_generator<boost::rand48, std::ptrdiff_t> rng(random);
+    CGAL::cpp98::random_shuffle(sites.begin(), sites.end(), rng);
+    CGAL::Multiscale_sort<HilbertSort>(HilbertSort(threads), ROUND_FROM, ROUND_RATIO)(
+        sites.begin(), sites.end());
     for (int i = 0; i < n; ++i)
       order[i] = sites[i].second;
   }
