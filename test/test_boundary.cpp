@@ -5,8 +5,12 @@
 
 #include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/triangulation.h>
+#include <pcl/surface/cocone/voronoi_cell.h>
 
 #include <gtest/gtest.h>
+
+#include "support/surfaces.h"
 
 #include <algorithm>
 #include <cmath>
@@ -102,6 +106,36 @@ TEST(DetectBoundary, PoleLinesNotVectors)
   vc.pole[3] = -tilted(0);
   vc.triangles.push_back({{0, 2, 3}, 0b001});
   EXPECT_TRUE(detectBoundary(vc, {1.5, M_PI / 6}).flat[3]);
+}
+
+TEST(DetectBoundary, SameLabelsWithSeveralThreads)
+{
+  // Enough co-cone triangles (about two a point) for the passes over them to run in
+  // parts, and noise, so that the growth of R has points to take.
+  cocone_test::SampleOptions o;
+  o.n = 80000;
+  o.even = false;
+  o.noise = 0.15;
+  o.seed = 3;
+  const auto s = cocone_test::monkeySaddle(o);
+  const Triangulation dt = triangulate(makeUniquePoints(s.points).points);
+  const VoronoiCells cells = computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
+  ASSERT_GT(cells.triangles.size(), 2u * 65536u);
+  const std::vector<double> spacing = localSpacing(dt.points, cells);
+  const FlatnessParameters parameters{1.5, M_PI / 6, 3.0};
+  const BoundaryLabels alone = detectBoundary(cells, parameters, spacing);
+  const auto count = [](const std::vector<std::uint8_t>& x) {
+    return std::count(x.begin(), x.end(), 1);
+  };
+  EXPECT_GT(count(alone.interior), count(alone.flat));                   // grown
+  EXPECT_LT(count(alone.interior), static_cast<long>(dt.points.size())); // a border
+  for (const int threads : {2, 3}) {
+    EXPECT_EQ(localSpacing(dt.points, cells, threads), spacing) << threads;
+    const BoundaryLabels l = detectBoundary(cells, parameters, spacing, threads);
+    EXPECT_EQ(l.ratio_ok, alone.ratio_ok) << threads;
+    EXPECT_EQ(l.flat, alone.flat) << threads;
+    EXPECT_EQ(l.interior, alone.interior) << threads;
+  }
 }
 
 TEST(LargestAngularGap, SameAsSortingTheAngles)

@@ -6,6 +6,8 @@
 #include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/complex.h>
 
+#include "edge_sort.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -16,19 +18,23 @@ namespace pcl {
 namespace cocone {
 
 std::vector<double>
-localSpacing(const std::vector<Eigen::Vector3d>& points, const VoronoiCells& cells)
+localSpacing(const std::vector<Eigen::Vector3d>& points,
+             const VoronoiCells& cells,
+             int threads)
 {
   constexpr int K = 6;
-  const std::size_t n = points.size();
+  const auto n = static_cast<std::ptrdiff_t>(points.size());
   std::vector<double> mean(n, 0.0);
-  for (std::size_t v = 0; v < n; ++v) {
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+  for (std::ptrdiff_t v = 0; v < n; ++v) {
     int count = 0;
     for (; count < K && cells.nearest[v][count] >= 0; ++count)
       mean[v] += (points[cells.nearest[v][count]] - points[v]).norm();
     mean[v] = count ? mean[v] / count : 0.0;
   }
   std::vector<double> s = mean;
-  for (std::size_t v = 0; v < n; ++v)
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+  for (std::ptrdiff_t v = 0; v < n; ++v)
     for (int k = 0; k < K && cells.nearest[v][k] >= 0; ++k)
       s[v] = std::max(s[v], mean[cells.nearest[v][k]]);
   return s;
@@ -138,14 +144,16 @@ automaticRatio(const VoronoiCells& cells)
 BoundaryLabels
 detectBoundary(const VoronoiCells& cells,
                const FlatnessParameters& parameters,
-               const std::vector<double>& spacing)
+               const std::vector<double>& spacing,
+               int threads)
 {
   const std::size_t n = cells.pole.size();
   BoundaryLabels out;
   out.ratio = parameters.ratio > 0.0 ? parameters.ratio : automaticRatio(cells);
   const double a = spacing.size() == n ? parameters.spacing_factor : 0.0;
   out.ratio_ok.assign(n, 0);
-  for (std::size_t v = 0; v < n; ++v) {
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+  for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(n); ++v) {
     const double w = cells.width[v];
     out.ratio_ok[v] = std::isfinite(w) && out.ratio * w <= cells.height(v) &&
                       (a <= 0.0 || w <= a * spacing[v]);
@@ -156,38 +164,53 @@ detectBoundary(const VoronoiCells& cells,
   const auto aligned = [&](int p, int q) {
     return std::abs(cells.pole[p].dot(cells.pole[q])) >= cos_theta;
   };
+  // Per co-cone neighbour relation q -> p (the dual edge of a triangle pq. meets
+  // C_q), in the order of the triangles.
+  const auto& triangles = cells.triangles;
+  const auto for_each_arc = [&](std::size_t begin, std::size_t end, const auto& arc) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const CoconeTriangle& t = triangles[i];
+      for (int k = 0; k < 3; ++k)
+        if (t.meets & (1u << k))
+          for (int j = 1; j < 3; ++j)
+            arc(t.v[k], t.v[(k + j) % 3]);
+    }
+  };
+  const int parts = detail::partsFor(triangles.size(), threads);
   // Normal condition, read in the paper's direction: p fails it if some q with
-  // p in N_q (the dual edge of a triangle pq. meets C_q) has a pole line too far off.
+  // p in N_q has a pole line too far off. (Every writer writes 1.)
   std::vector<std::uint8_t> normal_bad(n, 0);
-  for (const auto& t : cells.triangles)
-    for (int k = 0; k < 3; ++k)
-      if (t.meets & (1u << k))
-        for (int j = 1; j < 3; ++j) {
-          const int p = t.v[(k + j) % 3];
-          if (!normal_bad[p] && !aligned(p, t.v[k]))
-            normal_bad[p] = 1;
-        }
+  detail::forEachRange(triangles.size(), parts, [&](std::size_t b, std::size_t e, int) {
+    for_each_arc(b, e, [&](int q, int p) {
+      if (!__atomic_load_n(&normal_bad[p], __ATOMIC_RELAXED) && !aligned(p, q))
+        __atomic_store_n(&normal_bad[p], 1, __ATOMIC_RELAXED);
+    });
+  });
   out.flat.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     out.flat[v] = out.ratio_ok[v] && !normal_bad[v];
 
   // Growth: only a vertex that passes the ratio test but not the normal condition
-  // can join R, so only edges q -> p into such vertices are stored.
-  std::vector<std::pair<int, int>> arcs; // (q, p)
-  for (const auto& t : cells.triangles)
-    for (int k = 0; k < 3; ++k)
-      if (t.meets & (1u << k))
-        for (int j = 1; j < 3; ++j) {
-          const int p = t.v[(k + j) % 3], q = t.v[k];
+  // can join R, so only arcs q -> p into such vertices are kept, grouped by q.
+  std::vector<std::vector<std::pair<int, int>>> found(parts);
+  detail::forEachRange(
+      triangles.size(), parts, [&](std::size_t b, std::size_t e, int part) {
+        for_each_arc(b, e, [&](int q, int p) {
           if (out.ratio_ok[p] && !out.flat[p] && aligned(p, q))
-            arcs.emplace_back(q, p);
-        }
-  std::sort(arcs.begin(), arcs.end());
-  std::vector<std::size_t> first(n + 1, 0);
-  for (const auto& a : arcs)
-    ++first[a.first + 1];
-  for (std::size_t v = 0; v < n; ++v)
-    first[v + 1] += first[v];
+            found[part].emplace_back(q, p);
+        });
+      });
+  std::vector<std::pair<int, int>> arcs;
+  for (const auto& f : found)
+    arcs.insert(arcs.end(), f.begin(), f.end());
+  std::vector<std::vector<std::pair<int, int>>>().swap(found);
+  std::vector<int> head(arcs.size());
+  const std::vector<std::uint32_t> first = detail::countingSort(
+      arcs.size(),
+      n,
+      threads,
+      [&](std::size_t i) { return arcs[i].first; },
+      [&](std::size_t i, std::uint32_t place) { head[place] = arcs[i].second; });
 
   out.interior = out.flat;
   std::vector<int> queue;
@@ -198,7 +221,7 @@ detectBoundary(const VoronoiCells& cells,
     const int q = queue.back();
     queue.pop_back();
     for (std::size_t k = first[q]; k < first[q + 1]; ++k) {
-      const int p = arcs[k].second;
+      const int p = head[k];
       if (!out.interior[p]) {
         out.interior[p] = 1;
         queue.push_back(p);

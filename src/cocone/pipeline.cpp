@@ -184,7 +184,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   const bool half_disk = detect && parameters.gap_angle > 0.0;
   const std::vector<double> spacing =
       detect && (parameters.spacing_factor > 0.0 || half_disk)
-          ? localSpacing(dt.points, cells)
+          ? localSpacing(dt.points, cells, resolveThreads(parameters.threads))
           : std::vector<double>();
   HalfDisk test;
   if (half_disk)
@@ -212,7 +212,8 @@ runStages(std::vector<Eigen::Vector3d>&& points,
     const BoundaryLabels labels = detectBoundary(
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
-        spacing);
+        spacing,
+        resolveThreads(parameters.threads));
     result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];

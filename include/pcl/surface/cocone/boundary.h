@@ -34,9 +34,12 @@ struct FlatnessParameters {
  * the noise (w / s <= 1.3 measured), while at a border the cell reaches out several
  * spacings (w / s >= 3): unlike w / h, the ratio w / s does not depend on how the
  * border compares with the local feature size.
+ * \param[in] threads threads to compute with (the spacings do not depend on them)
  */
 std::vector<double>
-localSpacing(const std::vector<Eigen::Vector3d>& points, const VoronoiCells& cells);
+localSpacing(const std::vector<Eigen::Vector3d>& points,
+             const VoronoiCells& cells,
+             int threads = 1);
 
 /** \brief Outcome of the half-disk test (see halfDiskTest()). */
 struct HalfDisk {
@@ -115,11 +118,13 @@ struct BoundaryLabels {
  * \param[in] parameters rho, theta and the spacing factor
  * \param[in] spacing per vertex s_p (localSpacing()); needed if the spacing factor
  *            is not 0
+ * \param[in] threads threads to test with (the labels do not depend on them)
  */
 BoundaryLabels
 detectBoundary(const VoronoiCells& cells,
                const FlatnessParameters& parameters,
-               const std::vector<double>& spacing = {});
+               const std::vector<double>& spacing = {},
+               int threads = 1);
 
 } // namespace cocone
 } // namespace pcl
