@@ -710,7 +710,7 @@ using SiteIterator = std::vector<Site>::iterator;
  * levels of its median splits here, the rest by its own recursion on each octant. */
 class HilbertSort {
 public:
-  HilbertSort(int threads) : threads_(threads) {}
+  explicit HilbertSort(int threads) : threads_(threads) {}
 
   void
   operator()(SiteIterator begin, SiteIterator end) const
@@ -720,27 +720,26 @@ public:
       curve_.recursive_sort<0, false, false, false>(begin, end);
       return;
     }
-    // The curve's first level: halves in x, quarters in y (the second one turned),
-    // eighths in z, as CGAL splits them (nth_element at the middle).
+    // The curve's first level: halves in x, quarters in y, eighths in z, every
+    // second part's split turned, as CGAL splits them (nth_element at the middle);
+    // the parts of a level side by side.
+    const auto each = [&](int count, const auto& body) {
+      detail::forEachRange(
+          count, std::min(threads_, count), [&](std::size_t b, std::size_t e, int) {
+            for (std::size_t k = b; k < e; ++k)
+              body(k);
+          });
+    };
     std::array<SiteIterator, 9> m;
     m[0] = begin;
     m[8] = end;
-    m[4] = split(m[0], m[8], 0, false);
-    detail::forEachRange(
-        2, std::min(threads_, 2), [&](std::size_t b, std::size_t e, int) {
-          for (std::size_t k = b; k < e; ++k)
-            m[2 + 4 * k] = split(m[4 * k], m[4 * k + 4], 1, k == 1);
-        });
-    detail::forEachRange(
-        4, std::min(threads_, 4), [&](std::size_t b, std::size_t e, int) {
-          for (std::size_t k = b; k < e; ++k)
-            m[1 + 2 * k] = split(m[2 * k], m[2 * k + 2], 2, k % 2 == 1);
-        });
-    detail::forEachRange(
-        8, std::min(threads_, 8), [&](std::size_t b, std::size_t e, int) {
-          for (std::size_t k = b; k < e; ++k)
-            octant(static_cast<int>(k), m[k], m[k + 1]);
-        });
+    int axis = 0;
+    for (std::size_t width = 8; width > 1; width /= 2, ++axis)
+      each(static_cast<int>(8 / width), [&](std::size_t k) {
+        m[k * width + width / 2] =
+            split(m[k * width], m[(k + 1) * width], axis, k % 2 == 1);
+      });
+    each(8, [&](std::size_t k) { octant(static_cast<int>(k), m[k], m[k + 1]); });
   }
 
 private:

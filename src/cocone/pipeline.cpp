@@ -149,6 +149,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
           const std::vector<int>& ids)
 {
   Result result;
+  const int threads = resolveThreads(parameters.threads);
   Stopwatch clock;
   const auto id = [&](std::size_t i) {
     return ids.empty() ? static_cast<int>(i) : ids[i];
@@ -164,8 +165,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
     return result;
   }
 
-  Triangulation dt =
-      triangulate(std::move(unique.points), resolveThreads(parameters.threads));
+  Triangulation dt = triangulate(std::move(unique.points), threads);
   result.timings.delaunay = clock.lap();
   if (dt.dimension < 2) {
     result.error = "the points are collinear";
@@ -184,16 +184,12 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   const bool half_disk = detect && parameters.gap_angle > 0.0;
   const std::vector<double> spacing =
       detect && (parameters.spacing_factor > 0.0 || half_disk)
-          ? localSpacing(dt.points, cells, resolveThreads(parameters.threads))
+          ? localSpacing(dt.points, cells, threads)
           : std::vector<double>();
   HalfDisk test;
   if (half_disk)
-    test = halfDiskTest(dt.points,
-                        cells,
-                        spacing,
-                        parameters.gap_reach,
-                        parameters.gap_angle,
-                        resolveThreads(parameters.threads));
+    test = halfDiskTest(
+        dt.points, cells, spacing, parameters.gap_reach, parameters.gap_angle, threads);
   std::vector<std::array<int, VoronoiCells::NEAREST>>().swap(cells.nearest);
   result.timings.boundary = clock.lap();
 
@@ -213,7 +209,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
         cells,
         {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
         spacing,
-        resolveThreads(parameters.threads));
+        threads);
     result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];

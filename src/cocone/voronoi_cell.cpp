@@ -180,6 +180,27 @@ constexpr std::array<unsigned, 4> EDGES_AT = [] {
   return at;
 }();
 
+/** Where a point y lies from p, seen along the pole line: its component along the
+ * pole, and (along^2 - c^2 |y - p|^2, c the co-cone angle's cosine) whether it is off
+ * the co-cone (> 0), in one nappe of the double cone around the pole line. */
+struct ConeSide {
+  double along, off;
+};
+
+ConeSide
+coneSide(double along, double length2, double c2)
+{
+  return {along, along * along - c2 * length2};
+}
+
+/** Both ends of a segment in one nappe, which is convex: the segment misses the
+ * co-cone. (Off the co-cone, along is not 0.) */
+bool
+inOneNappe(const ConeSide& a, const ConeSide& b)
+{
+  return a.off > 0.0 && b.off > 0.0 && (a.along > 0.0) == (b.along > 0.0);
+}
+
 /** Raise *target to x atomically. */
 void
 atomicMax(double* target, double x)
@@ -203,23 +224,20 @@ intersectCocone(const Eigen::Vector3d& p,
 {
   // f(t) = ((y - p).u)^2 - c^2 |y - p|^2 <= 0 with y = a + t d.
   const Eigen::Vector3d e = a - p;
+  const double c2 = cos_angle * cos_angle;
   const double eu = e.dot(pole), du = d.dot(pole);
   const double ee = e.squaredNorm(), dd = d.squaredNorm(), ed = e.dot(d);
-  const double c2 = cos_angle * cos_angle;
+  const ConeSide start = coneSide(eu, ee, c2);
   const double A = du * du - c2 * dd;
   const double B = 2.0 * (eu * du - c2 * ed);
-  const double C = eu * eu - c2 * ee;
+  const double C = start.off;
   const double t_max = ray ? INF : 1.0;
 
   CoconeHit hit;
   // Most Voronoi edges lie in one nappe of the double cone around the pole line, the
   // complement of the co-cone: both ends there (for a ray, its start and its
-  // direction), on the same side of p. A nappe is convex, so the edge misses.
-  const bool start_out = C > 0.0;
-  const bool end_out = ray ? A > 0.0 : A + B + C > 0.0;
-  const double end_side = ray ? du : eu + du;
-  // (Outside the co-cone, neither eu nor end_side can be 0.)
-  if (start_out && end_out && (eu > 0.0) == (end_side > 0.0))
+  // direction), on the same side of p.
+  if (inOneNappe(start, ray ? ConeSide{du, A} : ConeSide{eu + du, A + B + C}))
     return hit;
   const auto consider = [&](double t) {
     if (!(t >= 0.0 && t <= t_max))
@@ -415,110 +433,103 @@ computeCocones(const Triangulation& dt,
     vc.triangles.insert(vc.triangles.end(), batch[thread].begin(), batch[thread].end());
     batch[thread].clear();
   };
-  forEachCell(dt,
-              CellView::CIRCUMCENTER | CellView::NEIGHBORS,
-              threads,
-              [&](const CellView& cell, int thread) {
-                for (const int a : cell.ahead)
-                  if (a >= 0) {
-                    __builtin_prefetch(&P[a]);
-                    __builtin_prefetch(&vc.pole[a]);
-                    __builtin_prefetch(&neg2[a]);
-                    __builtin_prefetch(&width[a]);
-                  }
-                // Per corner: where the Voronoi vertex lies from it, along its pole
-                // (s) and off its co-cone (q > 0: in one nappe of the double cone
-                // around the pole line, the co-cone's complement). A candidate for
-                // the negative pole, and one end of the Voronoi edges of the
-                // corner's facets.
-                const Eigen::Vector3d& cc = cell.circumcenter;
-                const bool finite = isFinite(cc);
-                std::array<double, 4> s{}, q{};
-                if (finite)
-                  for (int j = 0; j < 4; ++j) {
-                    const int v = cell.v[j];
-                    const Eigen::Vector3d y = cc - P[v];
-                    s[j] = y.dot(vc.pole[v]);
-                    const double yy = y.squaredNorm();
-                    if (s[j] < 0.0)
-                      atomicMax(&neg2[v], yy);
-                    q[j] = s[j] * s[j] - c2 * yy;
-                  }
-                for (int i = 0; i < 4; ++i) {
-                  if (cell.facet[i] == FacetRole::SHARED)
-                    continue;
-                  const bool ray = cell.facet[i] == FacetRole::HULL;
-                  // Most Voronoi edges have both ends in one nappe of each of their
-                  // corners' double cones, which is convex: they miss the co-cones.
-                  // intersectCocone rejects them so too, but only after setting up
-                  // the edge; here the ends' values above decide (the same bits at
-                  // the edge's first end, its far end read directly instead of off
-                  // the expanded quadratic). The corners left get the whole test.
-                  unsigned test = 0;
-                  for (int j = 0; j < 4; ++j)
-                    if (j != i)
-                      test |= 1u << j;
-                  const Eigen::Vector3d& other = cell.neighbor_circumcenter[i];
-                  if (!ray) {
-                    if (!finite || !isFinite(other))
-                      continue;
-                    for (int j = 0; j < 4; ++j) {
-                      if (j == i || !(q[j] > 0.0))
-                        continue;
-                      const int v = cell.v[j];
-                      const Eigen::Vector3d y = other - P[v];
-                      const double sy = y.dot(vc.pole[v]);
-                      if (sy * sy - c2 * y.squaredNorm() > 0.0 &&
-                          (sy > 0.0) == (s[j] > 0.0))
-                        test &= ~(1u << j);
-                    }
-                    if (!test)
-                      continue;
-                  }
-                  const auto f = detail::oppositeFacet(cell.v, i).ids;
-                  Eigen::Vector3d a = cc, d;
-                  if (ray) {
-                    d = outwardNormal(P, f, cell.outwardSide(i));
-                    // An unbounded Voronoi edge going to the negative side puts
-                    // v- at infinity.
-                    for (const int v : f)
-                      if (d.dot(vc.pole[v]) < 0.0)
-                        atomicMax(&neg2[v], INF);
-                  }
-                  else {
-                    // Orient the segment canonically so the test is bitwise
-                    // reproducible.
-                    Eigen::Vector3d b = other;
-                    if (lexLess(b, a))
-                      std::swap(a, b);
-                    d = b - a;
-                  }
-                  if (!isFinite(a) || !isFinite(d))
-                    continue;
-                  std::uint8_t meets = 0;
-                  for (int k = 0; k < 3; ++k) {
-                    const int v = f[k];
-                    int j = 0;
-                    while (cell.v[j] != v)
-                      ++j;
-                    if (!(test >> j & 1u))
-                      continue;
-                    const CoconeHit hit =
-                        intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
-                    if (hit.meets) {
-                      meets |= static_cast<std::uint8_t>(1u << k);
-                      atomicMax(&width[v], hit.max_distance);
-                      if (!met[v])
-                        __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
-                    }
-                  }
-                  if (meets) {
-                    batch[thread].push_back({f, meets});
-                    if (batch[thread].size() == 4096)
-                      append(thread);
-                  }
-                }
-              });
+  forEachCell(
+      dt,
+      CellView::CIRCUMCENTER | CellView::NEIGHBORS,
+      threads,
+      [&](const CellView& cell, int thread) {
+        for (const int a : cell.ahead)
+          if (a >= 0) {
+            __builtin_prefetch(&P[a]);
+            __builtin_prefetch(&vc.pole[a]);
+            __builtin_prefetch(&neg2[a]);
+            __builtin_prefetch(&width[a]);
+          }
+        // Per corner: where the Voronoi vertex lies from it (coneSide), a
+        // candidate for the negative pole and one end of the Voronoi edges
+        // of the corner's facets.
+        const Eigen::Vector3d& cc = cell.circumcenter;
+        const bool finite = isFinite(cc);
+        std::array<ConeSide, 4> side{};
+        if (finite)
+          for (int j = 0; j < 4; ++j) {
+            const int v = cell.v[j];
+            const Eigen::Vector3d y = cc - P[v];
+            const double yy = y.squaredNorm();
+            side[j] = coneSide(y.dot(vc.pole[v]), yy, c2);
+            if (side[j].along < 0.0)
+              atomicMax(&neg2[v], yy);
+          }
+        for (int i = 0; i < 4; ++i) {
+          if (cell.facet[i] == FacetRole::SHARED)
+            continue;
+          const bool ray = cell.facet[i] == FacetRole::HULL;
+          // Most Voronoi edges have both ends in one nappe of each of their
+          // corners' double cones, which is convex: they miss the co-cones.
+          // intersectCocone rejects them so too, but only after setting up
+          // the edge; here the ends' values above decide (the same bits at
+          // the edge's first end, its far end read directly instead of off
+          // the expanded quadratic). The corners left get the whole test.
+          unsigned test = 0xfu & ~(1u << i);
+          const Eigen::Vector3d& other = cell.neighbor_circumcenter[i];
+          if (!ray) {
+            if (!finite || !isFinite(other))
+              continue;
+            for (int j = 0; j < 4; ++j) {
+              if (j == i || !(side[j].off > 0.0))
+                continue; // in the co-cone: no need to look at the far end
+              const int v = cell.v[j];
+              const Eigen::Vector3d y = other - P[v];
+              if (inOneNappe(side[j], coneSide(y.dot(vc.pole[v]), y.squaredNorm(), c2)))
+                test &= ~(1u << j);
+            }
+            if (!test)
+              continue;
+          }
+          const auto f = detail::oppositeFacet(cell.v, i).ids;
+          Eigen::Vector3d a = cc, d;
+          if (ray) {
+            d = outwardNormal(P, f, cell.outwardSide(i));
+            // An unbounded Voronoi edge going to the negative side puts
+            // v- at infinity.
+            for (const int v : f)
+              if (d.dot(vc.pole[v]) < 0.0)
+                atomicMax(&neg2[v], INF);
+          }
+          else {
+            // Orient the segment canonically so the test is bitwise
+            // reproducible.
+            Eigen::Vector3d b = other;
+            if (lexLess(b, a))
+              std::swap(a, b);
+            d = b - a;
+          }
+          if (!isFinite(a) || !isFinite(d))
+            continue;
+          std::uint8_t meets = 0;
+          for (int k = 0; k < 3; ++k) {
+            const int v = f[k];
+            int j = 0;
+            while (cell.v[j] != v)
+              ++j;
+            if (!(test >> j & 1u))
+              continue;
+            const CoconeHit hit =
+                intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
+            if (hit.meets) {
+              meets |= static_cast<std::uint8_t>(1u << k);
+              atomicMax(&width[v], hit.max_distance);
+              if (!met[v])
+                __atomic_store_n(&met[v], 1, __ATOMIC_RELAXED);
+            }
+          }
+          if (meets) {
+            batch[thread].push_back({f, meets});
+            if (batch[thread].size() == 4096)
+              append(thread);
+          }
+        }
+      });
   for (std::size_t v = 0; v < n; ++v)
     vc.height_minus[v] = std::sqrt(neg2[v]);
 
