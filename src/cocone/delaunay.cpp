@@ -50,6 +50,9 @@ struct SharedCells {
   std::vector<std::uint8_t> state;
   /** Cells [0, used) have been handed out to the builders, in blocks. */
   std::atomic<std::size_t> used{0};
+  /** Per builder, per vertex: its number on the boundary of the builder's latest
+   * hole (Builder::starHole()). */
+  std::vector<std::vector<std::uint8_t>> hole_vertex;
 };
 
 /** Bowyer-Watson insertion: find the cells whose circumsphere contains the new
@@ -72,7 +75,11 @@ public:
   , cells_(shared.cells)
   , tag_(static_cast<std::uint8_t>((id + 1) << 2))
   , concurrent_(concurrent)
-  {}
+  , hole_vertex_(shared.hole_vertex.at(id))
+  {
+    if (hole_vertex_.size() != points.size())
+      hole_vertex_.assign(points.size(), 0);
+  }
 
   /** Start from a tetrahedron of four points and its four infinite cells. */
   void
@@ -621,10 +628,89 @@ private:
     return c;
   }
 
-  /** Fill the hole with one new cell per boundary facet; new cells meet along the
-   * hole's boundary edges, each shared by two of them, matched in a hash table. */
+  /** Fill the hole with one new cell per boundary facet. */
   void
   starHole()
+  {
+    star_.clear();
+    for (const BoundaryFacet& b : boundary_) {
+      const int id = allocate();
+      BuildCell& cell = cells_[id];
+      cell.v = b.v;
+      cell.n[b.i] = b.across;
+      cells_[b.across >> 2].n[b.across & 3] = static_cast<std::uint32_t>(id * 4 + b.i);
+      star_.push_back(id);
+    }
+    if (!linkStarByNumbers())
+      linkStarByHashing();
+  }
+
+  /** The new cells meet along the hole's boundary edges. Seen from the new point, the
+   * hole's boundary is a closed surface, and its facets (each new cell's facet
+   * opposite the point, its corners in ORIENTED order) run through a shared edge in
+   * opposite directions: the new cell across the facet opposite A of boundary facet
+   * A B C is the one whose boundary facet runs from C to B. With the boundary's
+   * vertices numbered 1, 2, ... (0: the infinite vertex), a table of the directed
+   * edges finds it without a search. False, with nothing linked, where the hole has
+   * more vertices than the table. */
+  bool
+  linkStarByNumbers()
+  {
+    // The corners of the facet opposite corner i of a positively oriented cell, in
+    // an order that turns the same way for every i: ascending for an even i, two
+    // swapped for an odd one.
+    static constexpr int ORIENTED[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    // Every vertex of the hole marked unnumbered first: no clearing between holes.
+    for (const BoundaryFacet& b : boundary_)
+      for (const int k : ORIENTED[b.i])
+        if (b.v[k] != INFINITE)
+          hole_vertex_[b.v[k]] = UNNUMBERED;
+    int count = 1;
+    numbers_.resize(boundary_.size());
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const BoundaryFacet& b = boundary_[f];
+      for (int m = 0; m < 3; ++m) {
+        const int w = b.v[ORIENTED[b.i][m]];
+        if (w == INFINITE) {
+          numbers_[f][m] = 0;
+          continue;
+        }
+        std::uint8_t& number = hole_vertex_[w];
+        if (number == UNNUMBERED) {
+          if (count == HOLE_VERTICES)
+            return false;
+          number = static_cast<std::uint8_t>(count++);
+        }
+        numbers_[f][m] = number;
+      }
+    }
+    directed_.resize(std::size_t(HOLE_VERTICES) * HOLE_VERTICES);
+    const auto edge = [](std::uint8_t from, std::uint8_t to) {
+      return std::size_t(from) * HOLE_VERTICES + to;
+    };
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const auto& o = ORIENTED[boundary_[f].i];
+      const auto& x = numbers_[f];
+      const auto cell = static_cast<std::uint32_t>(star_[f]) * 4;
+      directed_[edge(x[1], x[2])] = cell + o[0];
+      directed_[edge(x[2], x[0])] = cell + o[1];
+      directed_[edge(x[0], x[1])] = cell + o[2];
+    }
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const auto& o = ORIENTED[boundary_[f].i];
+      const auto& x = numbers_[f];
+      auto& n = cells_[star_[f]].n;
+      n[o[0]] = directed_[edge(x[2], x[1])];
+      n[o[1]] = directed_[edge(x[0], x[2])];
+      n[o[2]] = directed_[edge(x[1], x[0])];
+    }
+    return true;
+  }
+
+  /** linkStarByNumbers() for a hole of any size: the new cells' edges opposite the
+   * point, each shared by two of them, matched in a hash table. */
+  void
+  linkStarByHashing()
   {
     std::size_t size = 16;
     while (size < boundary_.size() * 4)
@@ -635,13 +721,9 @@ private:
     // Probe only the first size slots: the table keeps the size of the largest hole
     // so far, a small hole stays in a few cache lines.
     const std::size_t mask = size - 1;
-    star_.clear();
-    for (const BoundaryFacet& b : boundary_) {
-      const int id = allocate();
-      BuildCell& cell = cells_[id];
-      cell.v = b.v;
-      cell.n[b.i] = b.across;
-      cells_[b.across >> 2].n[b.across & 3] = static_cast<std::uint32_t>(id * 4 + b.i);
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const BoundaryFacet& b = boundary_[f];
+      const int id = star_[f];
       // The facet opposite v[j] (j != i) contains q and the edge of the other two.
       for (int j = 0; j < 4; ++j) {
         if (j == b.i)
@@ -668,7 +750,6 @@ private:
           }
         }
       }
-      star_.push_back(id);
     }
   }
 
@@ -690,6 +771,16 @@ private:
   std::vector<BoundaryFacet> boundary_;
   std::vector<Edge> edges_;
   std::uint32_t stamp_ = 0;
+  /** Vertices a hole's boundary may have for linkStarByNumbers(), the infinite one
+   * included: 16 KB of directed edges. */
+  static constexpr int HOLE_VERTICES = 64;
+  static constexpr std::uint8_t UNNUMBERED = 0xff;
+  std::vector<std::uint8_t>& hole_vertex_;
+  /** Per boundary facet, its ORIENTED vertices' numbers. */
+  std::vector<std::array<std::uint8_t, 3>> numbers_;
+  /** Per directed edge of the hole's boundary (by its ends' numbers), the new cell's
+   * facet that contains it, as in BuildCell::n. */
+  std::vector<std::uint32_t> directed_;
   std::uint32_t random_ = 12345;
   /** Where the next walk starts. */
   int start_ = 0;
@@ -942,6 +1033,7 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   cells.resize(std::size_t(n) * 16 + 64);
   SharedCells shared(cells);
   shared.state.assign(cells.size(), SharedCells::DEAD);
+  shared.hole_vertex.resize(std::min(std::max(threads, 1), int(Builder::MAX_BUILDERS)));
   Builder main(points, shared, 0, false);
   main.start(tetrahedron);
   for (std::size_t r = 0; r + 1 < rounds.size(); ++r)
