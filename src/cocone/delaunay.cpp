@@ -50,10 +50,11 @@ struct SharedCells {
   std::vector<std::uint8_t> state;
   /** Cells [0, used) have been handed out to the builders, in blocks. */
   std::atomic<std::size_t> used{0};
-  /** Per builder, per vertex: its number on the boundary of the builder's latest
-   * hole (Builder::starHole()). */
-  std::vector<std::vector<std::uint8_t>> hole_vertex;
 };
+
+/** The corners of the facet opposite corner i of a positively oriented cell, in
+ * CGAL's order: corner i lies on its positive side. */
+constexpr int FACET[4][3] = {{2, 1, 3}, {2, 3, 0}, {0, 3, 1}, {0, 1, 2}};
 
 /** Bowyer-Watson insertion: find the cells whose circumsphere contains the new
  * point (its conflict region, a star-shaped hole), free them and fill the hole with
@@ -75,11 +76,9 @@ public:
   , cells_(shared.cells)
   , tag_(static_cast<std::uint8_t>((id + 1) << 2))
   , concurrent_(concurrent)
-  , hole_vertex_(shared.hole_vertex.at(id))
-  {
-    if (hole_vertex_.size() != points.size())
-      hole_vertex_.assign(points.size(), 0);
-  }
+  , hole_vertex_(points.size())
+  , directed_(std::size_t(HOLE_VERTICES) * HOLE_VERTICES)
+  {}
 
   /** Start from a tetrahedron of four points and its four infinite cells. */
   void
@@ -409,11 +408,9 @@ private:
     if (i3 < 0)
       return sideOfOrientedSphere(
                  point(v[0]), point(v[1]), point(v[2]), point(v[3]), p) > 0;
-    // The finite facet, in CGAL's order for the infinite vertex at i3.
-    const int i0 = (i3 % 2 == 1) ? (i3 + 1) & 3 : (i3 + 2) & 3;
-    const int i1 = (i3 % 2 == 1) ? (i3 + 2) & 3 : (i3 + 1) & 3;
-    const int i2 = (i3 + 3) & 3;
-    const Point &a = point(v[i0]), &b = point(v[i1]), &c = point(v[i2]);
+    // The finite facet, the infinite vertex on its positive side.
+    const auto& f = FACET[i3];
+    const Point &a = point(v[f[0]]), &b = point(v[f[1]]), &c = point(v[f[2]]);
     const auto o = Kernel::Orientation_3()(a, b, c, p);
     if (o != CGAL::COPLANAR)
       return o == CGAL::POSITIVE;
@@ -647,7 +644,7 @@ private:
 
   /** The new cells meet along the hole's boundary edges. Seen from the new point, the
    * hole's boundary is a closed surface, and its facets (each new cell's facet
-   * opposite the point, its corners in ORIENTED order) run through a shared edge in
+   * opposite the point, its corners in FACET order) run through a shared edge in
    * opposite directions: the new cell across the facet opposite A of boundary facet
    * A B C is the one whose boundary facet runs from C to B. With the boundary's
    * vertices numbered 1, 2, ... (0: the infinite vertex), a table of the directed
@@ -656,13 +653,9 @@ private:
   bool
   linkStarByNumbers()
   {
-    // The corners of the facet opposite corner i of a positively oriented cell, in
-    // an order that turns the same way for every i: ascending for an even i, two
-    // swapped for an odd one.
-    static constexpr int ORIENTED[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
     // Every vertex of the hole marked unnumbered first: no clearing between holes.
     for (const BoundaryFacet& b : boundary_)
-      for (const int k : ORIENTED[b.i])
+      for (const int k : FACET[b.i])
         if (b.v[k] != INFINITE)
           hole_vertex_[b.v[k]] = UNNUMBERED;
     int count = 1;
@@ -670,7 +663,7 @@ private:
     for (std::size_t f = 0; f < boundary_.size(); ++f) {
       const BoundaryFacet& b = boundary_[f];
       for (int m = 0; m < 3; ++m) {
-        const int w = b.v[ORIENTED[b.i][m]];
+        const int w = b.v[FACET[b.i][m]];
         if (w == INFINITE) {
           numbers_[f][m] = 0;
           continue;
@@ -684,12 +677,11 @@ private:
         numbers_[f][m] = number;
       }
     }
-    directed_.resize(std::size_t(HOLE_VERTICES) * HOLE_VERTICES);
     const auto edge = [](std::uint8_t from, std::uint8_t to) {
       return std::size_t(from) * HOLE_VERTICES + to;
     };
     for (std::size_t f = 0; f < boundary_.size(); ++f) {
-      const auto& o = ORIENTED[boundary_[f].i];
+      const auto& o = FACET[boundary_[f].i];
       const auto& x = numbers_[f];
       const auto cell = static_cast<std::uint32_t>(star_[f]) * 4;
       directed_[edge(x[1], x[2])] = cell + o[0];
@@ -697,7 +689,7 @@ private:
       directed_[edge(x[0], x[1])] = cell + o[2];
     }
     for (std::size_t f = 0; f < boundary_.size(); ++f) {
-      const auto& o = ORIENTED[boundary_[f].i];
+      const auto& o = FACET[boundary_[f].i];
       const auto& x = numbers_[f];
       auto& n = cells_[star_[f]].n;
       n[o[0]] = directed_[edge(x[2], x[1])];
@@ -775,8 +767,10 @@ private:
    * included: 16 KB of directed edges. */
   static constexpr int HOLE_VERTICES = 64;
   static constexpr std::uint8_t UNNUMBERED = 0xff;
-  std::vector<std::uint8_t>& hole_vertex_;
-  /** Per boundary facet, its ORIENTED vertices' numbers. */
+  /** Per vertex its number on the latest hole's boundary; written before read, so
+   * never cleared (nor, until used, in memory). */
+  std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> hole_vertex_;
+  /** Per boundary facet, its FACET vertices' numbers. */
   std::vector<std::array<std::uint8_t, 3>> numbers_;
   /** Per directed edge of the hole's boundary (by its ends' numbers), the new cell's
    * facet that contains it, as in BuildCell::n. */
@@ -1033,7 +1027,6 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
   cells.resize(std::size_t(n) * 16 + 64);
   SharedCells shared(cells);
   shared.state.assign(cells.size(), SharedCells::DEAD);
-  shared.hole_vertex.resize(std::min(std::max(threads, 1), int(Builder::MAX_BUILDERS)));
   Builder main(points, shared, 0, false);
   main.start(tetrahedron);
   for (std::size_t r = 0; r + 1 < rounds.size(); ++r)
