@@ -236,3 +236,43 @@ TEST(HalfDiskTest, GridBorderAndInterior)
   EXPECT_EQ(inside_rim, 0u);
   EXPECT_NEAR(h.angle, 80.0 * M_PI / 180.0, 1e-12);
 }
+
+TEST(HalfDiskTest, LargeCloudBorder)
+{
+  // Above 131,072 points the gap angle comes from a sample of the gaps and only the
+  // points whose one-ring leaves a gap above it get their two-ring: the rim still
+  // runs along the border of a hemisphere (at height 0), and does not depend on
+  // the number of threads.
+  cocone_test::SampleOptions o;
+  o.n = 140000;
+  o.even = false;
+  o.seed = 5;
+  const auto s = cocone_test::hemisphere(o);
+  const UniquePoints unique = makeUniquePoints(s.points);
+  const Triangulation dt = triangulate(unique.points);
+  const VoronoiCells cells = computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
+  const std::vector<double> spacing = localSpacing(dt.points, cells);
+  const double gap_angle = 80.0 * M_PI / 180.0;
+  const HalfDisk h = halfDiskTest(dt.points, cells, spacing, 1.75, gap_angle);
+  // Random samples: the median gap is about 75 degrees, the angle about twice 80.
+  EXPECT_GT(h.angle, 1.8 * gap_angle);
+  EXPECT_LT(h.angle, 2.6 * gap_angle);
+  std::size_t border = 0, border_rim = 0, rim = 0, far_rim = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const int v = unique.vertex_of_input[i];
+    border += s.near_boundary[i];
+    border_rim += s.near_boundary[i] && h.rim[v];
+    rim += h.rim[v];
+    far_rim += h.rim[v] && s.points[i].z() > 3.0 * s.spacing;
+  }
+  // Measured: 122 rim points, 110 of the 477 within a spacing of the border (the
+  // gap angle of a random sample, 176 degrees, is met by the outermost points only;
+  // the flatness test labels the rest), 6 higher than 3 spacings.
+  EXPECT_GT(rim, border / 5);
+  EXPECT_GT(border_rim, 8 * rim / 10);
+  EXPECT_LT(far_rim, rim / 10);
+  const HalfDisk two = halfDiskTest(dt.points, cells, spacing, 1.75, gap_angle, 2);
+  EXPECT_EQ(two.angle, h.angle);
+  EXPECT_EQ(two.gap, h.gap);
+  EXPECT_EQ(two.rim, h.rim);
+}

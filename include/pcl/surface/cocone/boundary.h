@@ -44,7 +44,9 @@ localSpacing(const std::vector<Eigen::Vector3d>& points,
 /** \brief Outcome of the half-disk test (see halfDiskTest()). */
 struct HalfDisk {
   /** Per vertex: the largest angle between consecutive nearby neighbours seen along
-   * the pole line; 2 pi when fewer than two neighbours are near. */
+   * the pole line; 2 pi when fewer than two neighbours are near. Exact where it
+   * exceeds the gap angle used (and at the median's sample); elsewhere the gap seen
+   * through the one-ring alone, an upper bound that is at most that angle. */
   std::vector<double> gap;
   /** The gap angle used: the one asked for, times (median gap / 50 degrees)^2 if
    * that is more than 1. */
@@ -71,7 +73,9 @@ struct HalfDisk {
  * surface grow with the irregularity of the sample: their median is about 50
  * degrees on range grids and even samples and 75 on area-uniform random samples,
  * where 80 degrees would flag a third of the points. The gap angle used is
- * \a gap_angle times (median gap / 50 degrees)^2 when that is larger.
+ * \a gap_angle times (median gap / 50 degrees)^2 when that is larger; the median is
+ * that of all the vertices below 131,072, of a sample of 65,536 to 131,071 spread
+ * evenly along the ids (a space-filling curve) above.
  *
  * \param[in] points the triangulation's points
  * \param[in] cells stage 2 output (the poles, the nearest neighbours)
