@@ -231,8 +231,20 @@ walk(const TriangleComplex& complex,
       if (processed[e])
         continue;
       processed[e] = 1;
-      int a = -1;
-      const int t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
+      int a = -1, t2 = -1;
+      if (complex.edgeEnd(e) - complex.edgeBegin(e) == 2) {
+        // Most edges: the other triangle, taken where the two make an angle above
+        // pi / 2 (the complex knows), as neighborAcross() would take it.
+        const std::size_t i = complex.edgeBegin(e);
+        t2 = complex.edgeTriangle(i) == p.t ? complex.edgeTriangle(i + 1)
+                                            : complex.edgeTriangle(i);
+        if (!present[t2] || complex.acutePair(e))
+          continue;
+        const auto& v = complex.triangle(t2);
+        a = v[0] + v[1] + v[2] - p.x - p.y;
+      }
+      else
+        t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
       if (t2 < 0)
         continue;
       const Triangle next{p.y, p.x, a};

@@ -116,6 +116,15 @@ public:
     return vertex_triangles_[i];
   }
 
+  /** For an edge of exactly two triangles: whether they make an angle below pi / 2
+   * (their directions from the edge, orthogonal to it, have a positive dot product).
+   */
+  bool
+  acutePair(int e) const
+  {
+    return acute_pair_[e] != 0;
+  }
+
   /** ISSHARP: edge e is sharp among the triangles for which alive(t) is true if it has
    * exactly one, or two consecutive ones (in circular order) with an angular gap of
    * more than 3 pi / 2 between them. No triangle: not sharp. */
