@@ -525,6 +525,57 @@ TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)
   EXPECT_EQ(topology.components, 1u);
 }
 
+TEST(Repair, OrientsEachComponentWithAnyThreadCount)
+{
+  // Long bands (enough triangles for the threads to share them): an annulus with
+  // every third triangle turned over, a Moebius strip beside it, and a second
+  // annulus around it. The annuli come out consistent (each turned to its positive
+  // volume), the strip cut once, the same with one thread or two.
+  const int n = 12000;
+  std::vector<Eigen::Vector3d> P;
+  std::vector<pcl::cocone::Triangle> mesh;
+  const auto band = [&](double x, double radius, bool twist) {
+    const int first = static_cast<int>(P.size());
+    for (int i = 0; i < n; ++i) {
+      const double t = 2.0 * M_PI * i / n;
+      const Eigen::Vector3d centre(x + radius * std::cos(t), radius * std::sin(t), 0.0);
+      const Eigen::Vector3d radial(std::cos(t), std::sin(t), 0.0);
+      const double turn = twist ? t / 2.0 : 0.0;
+      const Eigen::Vector3d across =
+          std::cos(turn) * radial + std::sin(turn) * Eigen::Vector3d::UnitZ();
+      P.push_back(centre + 0.3 * across);
+      P.push_back(centre - 0.3 * across);
+    }
+    for (int i = 0; i < n; ++i) {
+      int a = first + 2 * ((i + 1) % n), b = a + 1;
+      if (twist && i == n - 1)
+        std::swap(a, b);
+      const int c = first + 2 * i;
+      mesh.push_back({c, c + 1, a});
+      mesh.push_back({c + 1, b, a});
+      if (!twist && i % 3 == 0)
+        std::swap(mesh.back()[1], mesh.back()[2]);
+    }
+  };
+  band(0.0, 1.0, false);
+  band(3.0, 1.0, true);
+  band(0.0, 2.0, false);
+  std::vector<pcl::cocone::Triangle> two = mesh;
+  pcl::cocone::RepairCounts counts, counts_two;
+  pcl::cocone::repairManifold(P, mesh, counts);
+  pcl::cocone::repairManifold(P, two, counts_two, 2);
+  EXPECT_EQ(two, mesh);
+  EXPECT_EQ(counts_two.flipped, counts.flipped);
+  EXPECT_EQ(counts_two.orientation, counts.orientation);
+  EXPECT_GE(counts.orientation, 1u);
+  EXPECT_LE(counts.dropped(), 3u);
+  EXPECT_GE(counts.flipped, static_cast<std::size_t>(2 * n / 3));
+  const auto topology = pcl::cocone::analyzeMesh(mesh, P.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.orientation_conflicts, 0u);
+  EXPECT_EQ(topology.components, 3u);
+}
+
 TEST(Reconstruction, Deterministic)
 {
   const auto s = cocone_test::monkeySaddle(options(5000, 0.05));

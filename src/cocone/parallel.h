@@ -2,7 +2,8 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * Splitting a loop among threads (not installed).
+ * Splitting a loop among threads, and sets that threads unite at once (not
+ * installed).
  */
 
 #pragma once
@@ -13,7 +14,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <new>
+#include <vector>
 
 namespace pcl {
 namespace cocone {
@@ -57,6 +60,80 @@ forEachRange(std::size_t count, int parts, const Body& body)
   if (failed)
     throw std::bad_alloc();
 }
+
+/** Disjoint sets of 0 .. n - 1 that several threads unite at once without locks,
+ * with a parity per element relative to the root of its set (a two-colouring that
+ * the unions constrain). The root of a set is its lowest element, as the larger of
+ * two roots is linked below the smaller: the roots, and the parities in a set whose
+ * constraints agree, do not depend on the order of the unions. */
+class ConcurrentParitySets {
+public:
+  explicit ConcurrentParitySets(std::size_t n, int threads) : link_(n)
+  {
+    const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for num_threads(threads) schedule(static, 65536)
+    for (std::ptrdiff_t i = 0; i < count; ++i)
+      link_[i] = static_cast<std::uint64_t>(i) << 1;
+  }
+
+  struct Found {
+    int root;
+    int parity; ///< of the element relative to the root
+  };
+
+  Found
+  find(int t)
+  {
+    int parity = 0;
+    for (;;) {
+      const std::uint64_t up = load(t);
+      const int parent = static_cast<int>(up >> 1);
+      if (parent == t)
+        return {t, parity};
+      const std::uint64_t above = load(parent);
+      const int grandparent = static_cast<int>(above >> 1);
+      if (grandparent == parent)
+        return {parent, parity ^ static_cast<int>(up & 1)};
+      // Halve the path: any ancestor, with the parity to it, keeps t in its set.
+      const std::uint64_t halved = (up ^ above) & 1;
+      __atomic_store_n(
+          &link_[t], static_cast<std::uint64_t>(grandparent) << 1 | halved, RELAXED);
+      parity ^= static_cast<int>(halved);
+      t = grandparent;
+    }
+  }
+
+  /** Join the sets of a and b, their parities to differ by \a odd (0 or 1); a
+   * constraint against the parities of a set already joined is not recorded. */
+  void
+  unite(int a, int b, int odd)
+  {
+    for (;;) {
+      Found x = find(a), y = find(b);
+      if (x.root == y.root)
+        return;
+      if (x.root > y.root)
+        std::swap(x, y);
+      std::uint64_t expected = static_cast<std::uint64_t>(y.root) << 1;
+      const std::uint64_t below = static_cast<std::uint64_t>(x.root) << 1 |
+                                  static_cast<std::uint64_t>(x.parity ^ y.parity ^ odd);
+      if (__atomic_compare_exchange_n(
+              &link_[y.root], &expected, below, false, RELAXED, RELAXED))
+        return;
+    }
+  }
+
+private:
+  static constexpr int RELAXED = __ATOMIC_RELAXED;
+
+  std::uint64_t
+  load(int t) const
+  {
+    return __atomic_load_n(&link_[t], RELAXED);
+  }
+
+  std::vector<std::uint64_t> link_;
+};
 
 } // namespace detail
 } // namespace cocone

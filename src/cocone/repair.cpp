@@ -8,6 +8,8 @@
 
 #include <Eigen/Geometry>
 
+#include "parallel.h"
+
 #include <algorithm>
 #include <limits>
 #include <queue>
@@ -201,19 +203,57 @@ orient(const std::vector<Eigen::Vector3d>& P,
     return (alike[t][k] ^ turned_over[t] ^ turned_over[across[t][k]]) != 0;
   };
 
-  // Each component grows from its lowest triangle, across the edge whose two
-  // triangles, oriented alike, agree best in their normals first (Prim's order). Where
-  // the mesh cannot be oriented (a fold that a walk left near a border) the
-  // disagreement then lands on the fold's own edges, not on a seam wherever two
-  // fronts of a breadth-first pass happen to meet.
+  // A component that can be oriented has one orientation given its lowest
+  // triangle's: a union-find with parity (turned or not relative to the root, its
+  // lowest triangle) finds it in parallel, and tells a component that cannot be
+  // oriented by an edge whose parities disagree.
+  const auto num_triangles = static_cast<std::ptrdiff_t>(m);
+  std::vector<int> component(m, -1);
+  std::vector<std::uint8_t> knotted(m, 0); // per root: cannot be oriented
+  {
+    detail::ConcurrentParitySets sets(m, threads);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+    for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (across[t][k] > t)
+          sets.unite(static_cast<int>(t), across[t][k], alike[t][k]);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+    for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
+      const auto found = sets.find(static_cast<int>(t));
+      component[t] = found.root;
+      turned_over[t] = static_cast<std::uint8_t>(found.parity);
+    }
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+    for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (across[t][k] > t && disagree(static_cast<int>(t), k))
+          __atomic_store_n(&knotted[component[t]], 1, __ATOMIC_RELAXED);
+  }
+  std::size_t turns = 0;
+#pragma omp parallel for num_threads(threads) schedule(static, 8192) reduction(+ : turns)
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
+    if (knotted[component[t]])
+      turned_over[t] = 0;
+    else if (turned_over[t]) {
+      std::swap(triangles[t][1], triangles[t][2]);
+      ++turns;
+    }
+  }
+  flipped += turns;
+
+  // A component that cannot be oriented grows from its lowest triangle, across the
+  // edge whose two triangles, oriented alike, agree best in their normals first
+  // (Prim's order). The disagreement then lands on the fold's own edges (a fold that
+  // a walk left near a border), not on a seam wherever two fronts of a
+  // breadth-first pass happen to meet.
   std::vector<Eigen::Vector3d> normal; // of the triangles grown in Prim's order
-  std::vector<int> component(m, -1), order(m, -1);
+  std::vector<int> order(m, -1);
   std::vector<std::uint8_t> drop(m, 0);
   std::vector<int> members;
   // (agreement, -triangle, -parent): the best agreement first, ties by lowest ids.
   using Entry = std::tuple<double, int, int>;
   std::priority_queue<Entry> heap;
-  int c = 0, rank = 0;
+  int rank = 0;
   const auto offer = [&](int t) {
     for (int k = 0; k < 3; ++k) {
       const int t2 = across[t][k];
@@ -224,58 +264,29 @@ orient(const std::vector<Eigen::Vector3d>& P,
       heap.emplace(agree, -t2, -t);
     }
   };
-  // A component that can be oriented has one orientation given its seed's: a
-  // breadth-first pass finds it, and only where it meets a disagreement does the
-  // order matter and the pass run again in Prim's order.
-  for (std::size_t s = 0; s < m; ++s, members.clear()) {
-    if (component[s] >= 0)
-      continue;
-    component[s] = c;
-    members.push_back(static_cast<int>(s));
-    bool consistent = true;
-    for (std::size_t q = 0; q < members.size(); ++q) {
-      const int t = members[q];
-      for (int k = 0; k < 3; ++k) {
-        const int t2 = across[t][k];
-        if (t2 < 0)
-          continue;
-        if (component[t2] >= 0) {
-          // Both oriented: each edge inside the component is met so at least once.
-          consistent = consistent && !disagree(t, k);
-          continue;
-        }
-        component[t2] = c;
-        members.push_back(t2);
-        if (disagree(t, k))
-          turn(t2);
-      }
-    }
-    // Each triangle is turned in its own component's pass only: so far, its turns
-    // are those of the breadth-first pass.
-    if (consistent) {
-      for (const int t : members)
-        flipped += turned_over[t];
-    }
-    else {
-      normal.resize(m);
-      for (const int t : members) {
-        if (turned_over[t])
-          turn(t);
+  const bool any_knotted =
+      std::find(knotted.begin(), knotted.end(), 1) != knotted.end();
+  if (any_knotted) {
+    normal.resize(m);
+    for (std::size_t t = 0; t < m; ++t)
+      if (knotted[component[t]]) {
         component[t] = -1;
         normal[t] = unitNormal(P, triangles[t]);
       }
-      members.clear();
-      component[s] = c;
-      order[s] = rank++;
-      members.push_back(static_cast<int>(s));
-      offer(static_cast<int>(s));
-    }
+  }
+  for (std::size_t s = 0; any_knotted && s < m; ++s) {
+    if (!knotted[s]) // only roots are marked
+      continue;
+    members.assign(1, static_cast<int>(s));
+    component[s] = static_cast<int>(s);
+    order[s] = rank++;
+    offer(static_cast<int>(s));
     while (!heap.empty()) {
       const int t2 = -std::get<1>(heap.top()), t = -std::get<2>(heap.top());
       heap.pop();
       if (component[t2] >= 0)
         continue;
-      component[t2] = c;
+      component[t2] = static_cast<int>(s);
       order[t2] = rank++;
       members.push_back(t2);
       int k = 0; // the side of t2 towards t
@@ -296,21 +307,36 @@ orient(const std::vector<Eigen::Vector3d>& P,
         if (t2 >= 0 && t2 < t && disagree(t, k) && !drop[t] && !drop[t2])
           drop[order[t] > order[t2] ? t : t2] = 1;
       }
-    // Turn the component so that its signed volume about its centroid is positive.
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const int t : members)
-      centre += P[triangles[t][0]] + P[triangles[t][1]] + P[triangles[t][2]];
-    centre /= 3.0 * static_cast<double>(members.size());
-    double volume = 0.0;
-    for (const int t : members) {
-      const auto& v = triangles[t];
-      volume += (P[v[0]] - centre).dot((P[v[1]] - centre).cross(P[v[2]] - centre));
-    }
-    if (volume < 0.0)
-      for (const int t : members)
-        turn(t);
-    ++c;
   }
+
+  // Turn each component so that its signed volume about its centroid is positive,
+  // both sums taken in the order of the triangles. The components are numbered in
+  // the order of their roots (in place of the order, no longer needed).
+  std::vector<int>& number = order;
+  std::size_t components = 0;
+  for (std::size_t t = 0; t < m; ++t)
+    if (component[t] == static_cast<int>(t))
+      number[t] = static_cast<int>(components++);
+  std::vector<Eigen::Vector3d> centre(components, Eigen::Vector3d::Zero());
+  std::vector<std::size_t> size(components, 0);
+  for (std::size_t t = 0; t < m; ++t) {
+    const auto& v = triangles[t];
+    const int c = number[component[t]];
+    centre[c] += P[v[0]] + P[v[1]] + P[v[2]];
+    ++size[c];
+  }
+  for (std::size_t c = 0; c < components; ++c)
+    centre[c] /= 3.0 * static_cast<double>(size[c]);
+  std::vector<double> volume(components, 0.0);
+  for (std::size_t t = 0; t < m; ++t) {
+    const auto& v = triangles[t];
+    const Eigen::Vector3d& o = centre[number[component[t]]];
+    volume[number[component[t]]] += (P[v[0]] - o).dot((P[v[1]] - o).cross(P[v[2]] - o));
+  }
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
+    if (volume[number[component[t]]] < 0.0)
+      turn(static_cast<int>(t));
   // The same edges; the turned triangles run them the other way.
   const auto incidences = static_cast<std::ptrdiff_t>(inc.triangle.size());
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)

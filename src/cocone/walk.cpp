@@ -8,10 +8,12 @@
 #include <Eigen/Geometry>
 
 #include "edge_sort.h"
+#include "parallel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <utility>
 
@@ -96,48 +98,22 @@ walk(const TriangleComplex& complex,
   WalkResult out;
 
   // Connected components of the present triangles (through shared edges), by a
-  // union-find over the edges in parallel: a set's root is its lowest triangle, as
-  // the larger of two roots is linked below the smaller.
+  // union-find over the edges in parallel: a set's root is its lowest triangle.
   const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
-  std::vector<int> parent(m);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&](int t) {
-    for (;;) {
-      const int up = __atomic_load_n(&parent[t], __ATOMIC_RELAXED);
-      if (up == t)
-        return t;
-      // Halve the path: any ancestor stays in the set.
-      const int above = __atomic_load_n(&parent[up], __ATOMIC_RELAXED);
-      if (above != up)
-        __atomic_store_n(&parent[t], above, __ATOMIC_RELAXED);
-      t = above;
-    }
-  };
+  auto sets = std::make_unique<detail::ConcurrentParitySets>(m, threads);
   std::vector<int> edge_count(num_edges, 0);
 #pragma omp parallel for num_threads(threads) schedule(static, 8192)
   for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
     int first = -1;
     for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
-      int t = complex.edgeTriangle(i);
+      const int t = complex.edgeTriangle(i);
       if (!present[t])
         continue;
       ++edge_count[e];
-      if (first < 0) {
+      if (first < 0)
         first = t;
-        continue;
-      }
-      for (int s = first;;) {
-        s = root(s);
-        t = root(t);
-        if (s == t)
-          break;
-        if (s > t)
-          std::swap(s, t);
-        int expected = t;
-        if (__atomic_compare_exchange_n(
-                &parent[t], &expected, s, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
-          break;
-      }
+      else
+        sets->unite(first, t, 0);
     }
   }
   const auto score = [&](int t) {
@@ -156,7 +132,7 @@ walk(const TriangleComplex& complex,
       continue;
     const std::uint64_t key =
         std::uint64_t(score(t) + 1) << 32 | static_cast<std::uint32_t>(m - t);
-    std::uint64_t* target = &best[root(t)];
+    std::uint64_t* target = &best[sets->find(t).root];
     std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
     while (key > seen &&
            !__atomic_compare_exchange_n(
@@ -166,10 +142,10 @@ walk(const TriangleComplex& complex,
   // The components in the order of their lowest triangles.
   std::vector<int> seeds;
   for (int t = 0; t < m; ++t)
-    if (present[t] && parent[t] == t)
+    if (present[t] && sets->find(t).root == t)
       seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
   std::vector<std::uint64_t>().swap(best);
-  std::vector<int>().swap(parent);
+  sets.reset();
   out.components = seeds.size();
 
   // The walk, as in the paper: every edge is processed once.
