@@ -70,6 +70,37 @@ reconstruct(const Sample& s, Parameters parameters = Parameters(), const char* t
   return run;
 }
 
+/** Append a band of 2 n triangles 0.6 wide about a circle of \a radius centred at
+ * (x, 0, 0) in the plane z = 0: an annulus, or with \a twist a Moebius strip. */
+void
+addBand(std::vector<Eigen::Vector3d>& P,
+        std::vector<pcl::cocone::Triangle>& mesh,
+        int n,
+        double x,
+        double radius,
+        bool twist)
+{
+  const int first = static_cast<int>(P.size());
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * M_PI * i / n;
+    const Eigen::Vector3d radial(std::cos(t), std::sin(t), 0.0);
+    const double turn = twist ? t / 2.0 : 0.0;
+    const Eigen::Vector3d across =
+        std::cos(turn) * radial + std::sin(turn) * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d centre = Eigen::Vector3d(x, 0.0, 0.0) + radius * radial;
+    P.push_back(centre + 0.3 * across);
+    P.push_back(centre - 0.3 * across);
+  }
+  for (int i = 0; i < n; ++i) {
+    int a = first + 2 * ((i + 1) % n), b = a + 1;
+    if (twist && i == n - 1)
+      std::swap(a, b);
+    const int c = first + 2 * i;
+    mesh.push_back({c, c + 1, a});
+    mesh.push_back({c + 1, b, a});
+  }
+}
+
 using Generator = std::function<Sample(const SampleOptions&)>;
 
 struct ClosedCase {
@@ -493,28 +524,66 @@ TEST(Walk, IncidencesReadOffTheComplexAsIfGrouped)
   }
 }
 
+TEST(Walk, SameWalkWithAnyThreadCount)
+{
+  // The co-cone triangles of a noisy saddle, all present: many patches of triangles
+  // joined by edges of two, and edges of three and more between them.
+  const auto s = cocone_test::monkeySaddle(options(70000, 0.1));
+  auto unique = pcl::cocone::makeUniquePoints(s.points);
+  const auto dt = pcl::cocone::triangulate(std::move(unique.points));
+  const auto cells = pcl::cocone::computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
+  std::vector<pcl::cocone::Triangle> triangles;
+  for (const auto& t : cells.triangles)
+    triangles.push_back(t.v);
+  const pcl::cocone::TriangleComplex complex(dt.points, triangles);
+  const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
+  const std::vector<std::uint8_t> boundary(dt.points.size(), 0);
+  const auto alone = pcl::cocone::walk(complex, present, boundary, 1);
+  for (const int threads : {2, 3}) {
+    const auto walked = pcl::cocone::walk(complex, present, boundary, threads);
+    EXPECT_EQ(walked.triangles, alone.triangles) << threads;
+    EXPECT_EQ(walked.ids, alone.ids) << threads;
+    EXPECT_EQ(walked.components, alone.components) << threads;
+    EXPECT_EQ(walked.conflicts, alone.conflicts) << threads;
+    EXPECT_EQ(walked.reseeds, alone.reseeds) << threads;
+  }
+}
+
+TEST(Walk, TwistedBandHasOneConflict)
+{
+  // An annulus and a Moebius strip of 3,000 triangles each, as candidates: the walk
+  // takes every triangle, the annulus oriented alike throughout, the strip with one
+  // edge where its orientations meet the other way round.
+  const int n = 1500;
+  std::vector<Eigen::Vector3d> P;
+  std::vector<pcl::cocone::Triangle> mesh;
+  addBand(P, mesh, n, 0.0, 1.0, false);
+  addBand(P, mesh, n, 3.0, 1.0, true);
+  const pcl::cocone::TriangleComplex complex(P, mesh);
+  const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
+  const std::vector<std::uint8_t> boundary(P.size(), 0);
+  for (const int threads : {1, 2}) {
+    const auto walked = pcl::cocone::walk(complex, present, boundary, threads);
+    EXPECT_EQ(walked.triangles.size(), mesh.size());
+    EXPECT_EQ(walked.components, 2u);
+    EXPECT_EQ(walked.conflicts, 1u);
+    std::vector<pcl::cocone::Triangle> annulus;
+    for (const auto& t : walked.triangles)
+      if (t[0] < 2 * n)
+        annulus.push_back(t);
+    const auto topology = pcl::cocone::analyzeMesh(annulus, P.size());
+    EXPECT_EQ(topology.orientation_conflicts, 0u);
+    EXPECT_EQ(topology.components, 1u);
+  }
+}
+
 TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)
 {
   // A band of 2n triangles with a half twist: no orientation agrees all round, so
   // the orientation step grows it in Prim's order and drops a triangle at the seam.
-  const int n = 40;
   std::vector<Eigen::Vector3d> P;
-  for (int i = 0; i < n; ++i) {
-    const double t = 2.0 * M_PI * i / n;
-    const Eigen::Vector3d centre(std::cos(t), std::sin(t), 0.0);
-    const Eigen::Vector3d across =
-        std::cos(t / 2.0) * centre + std::sin(t / 2.0) * Eigen::Vector3d::UnitZ();
-    P.push_back(centre + 0.3 * across);
-    P.push_back(centre - 0.3 * across);
-  }
   std::vector<pcl::cocone::Triangle> mesh;
-  for (int i = 0; i < n; ++i) {
-    int a = 2 * ((i + 1) % n), b = a + 1;
-    if (i == n - 1)
-      std::swap(a, b); // the twist
-    mesh.push_back({2 * i, 2 * i + 1, a});
-    mesh.push_back({2 * i + 1, b, a});
-  }
+  addBand(P, mesh, 40, 0.0, 1.0, true);
   pcl::cocone::RepairCounts counts;
   pcl::cocone::repairManifold(P, mesh, counts);
   EXPECT_GE(counts.orientation, 1u);
@@ -534,32 +603,12 @@ TEST(Repair, OrientsEachComponentWithAnyThreadCount)
   const int n = 12000;
   std::vector<Eigen::Vector3d> P;
   std::vector<pcl::cocone::Triangle> mesh;
-  const auto band = [&](double x, double radius, bool twist) {
-    const int first = static_cast<int>(P.size());
-    for (int i = 0; i < n; ++i) {
-      const double t = 2.0 * M_PI * i / n;
-      const Eigen::Vector3d centre(x + radius * std::cos(t), radius * std::sin(t), 0.0);
-      const Eigen::Vector3d radial(std::cos(t), std::sin(t), 0.0);
-      const double turn = twist ? t / 2.0 : 0.0;
-      const Eigen::Vector3d across =
-          std::cos(turn) * radial + std::sin(turn) * Eigen::Vector3d::UnitZ();
-      P.push_back(centre + 0.3 * across);
-      P.push_back(centre - 0.3 * across);
-    }
-    for (int i = 0; i < n; ++i) {
-      int a = first + 2 * ((i + 1) % n), b = a + 1;
-      if (twist && i == n - 1)
-        std::swap(a, b);
-      const int c = first + 2 * i;
-      mesh.push_back({c, c + 1, a});
-      mesh.push_back({c + 1, b, a});
-      if (!twist && i % 3 == 0)
-        std::swap(mesh.back()[1], mesh.back()[2]);
-    }
-  };
-  band(0.0, 1.0, false);
-  band(3.0, 1.0, true);
-  band(0.0, 2.0, false);
+  addBand(P, mesh, n, 0.0, 1.0, false);
+  addBand(P, mesh, n, 3.0, 1.0, true);
+  addBand(P, mesh, n, 0.0, 2.0, false);
+  for (std::size_t t = 0; t < mesh.size(); t += 6) // every third of the annuli's
+    if (t < 2 * n || t >= 4 * n)
+      std::swap(mesh[t][1], mesh[t][2]);
   std::vector<pcl::cocone::Triangle> two = mesh;
   pcl::cocone::RepairCounts counts, counts_two;
   pcl::cocone::repairManifold(P, mesh, counts);
