@@ -10,12 +10,40 @@
 namespace pcl {
 namespace cocone {
 
+namespace {
+
+/** Whether no edge at p is sharp to begin with: each has two triangles, which make
+ * an angle above pi / 2 (most vertices). The cascade then deletes nothing, and the
+ * umbrella is p's whole star. */
+bool
+wholeStar(const TriangleComplex& complex, int p)
+{
+  const std::size_t first = complex.vertexBegin(p), last = complex.vertexEnd(p);
+  for (std::size_t i = first; i < last; ++i) {
+    const int t = complex.vertexTriangle(i);
+    for (int k = 0; k < 3; ++k) {
+      const int e = complex.triangleEdges(t)[k];
+      if (complex.triangle(t)[k] != p && // the edges at p are those opposite the others
+          (complex.edgeEnd(e) - complex.edgeBegin(e) != 2 || complex.acutePair(e)))
+        return false;
+    }
+  }
+  return first != last;
+}
+
+} // namespace
+
 bool
 hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* kept)
 {
   const std::size_t first = complex.vertexBegin(p), last = complex.vertexEnd(p);
   if (first == last)
     return false;
+  if (wholeStar(complex, p)) {
+    for (std::size_t i = first; kept && i < last; ++i)
+      __atomic_fetch_add(&(*kept)[complex.vertexTriangle(i)], 1, __ATOMIC_RELAXED);
+    return true;
+  }
   // Every triangle at an edge pq contains p: the star is all the cascade can touch.
   // (The incidence list of a vertex is in ascending triangle order.)
   thread_local std::vector<int> star;
@@ -73,19 +101,30 @@ umbrellaFailures(const TriangleComplex& complex,
                  int threads)
 {
   std::vector<std::uint8_t> failed(boundary.size(), 0);
-  std::vector<std::uint8_t> kept;
+  // Per vertex: its umbrella is its whole star; per triangle, how many of the other
+  // umbrellas keep it.
+  std::vector<std::uint8_t> whole(boundary.size(), 0), kept;
   if (umbrella_triangles)
     kept.assign(complex.numTriangles(), 0);
   const auto n = static_cast<std::ptrdiff_t>(boundary.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
-  for (std::ptrdiff_t p = 0; p < n; ++p)
-    if (!boundary[p])
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    if (boundary[p])
+      continue;
+    if (wholeStar(complex, static_cast<int>(p)))
+      whole[p] = 1;
+    else
       failed[p] = !hasUmbrella(
           complex, static_cast<int>(p), umbrella_triangles ? &kept : nullptr);
+  }
   if (umbrella_triangles) {
-    umbrella_triangles->assign(complex.numTriangles(), 0);
-    for (std::size_t t = 0; t < kept.size(); ++t)
-      (*umbrella_triangles)[t] = kept[t] == 3;
+    umbrella_triangles->resize(complex.numTriangles());
+    const auto m = static_cast<std::ptrdiff_t>(complex.numTriangles());
+#pragma omp parallel for num_threads(threads) schedule(static, 16384)
+    for (std::ptrdiff_t t = 0; t < m; ++t) {
+      const auto& v = complex.triangle(static_cast<int>(t));
+      (*umbrella_triangles)[t] = kept[t] + whole[v[0]] + whole[v[1]] + whole[v[2]] == 3;
+    }
   }
   return failed;
 }
