@@ -566,7 +566,7 @@ private:
   bool
   reserveCells(std::size_t count)
   {
-    while (free_count_ + (end_ - next_) < count) {
+    while (free_.size() + (end_ - next_) < count) {
       const std::size_t size = std::max(BLOCK, count);
       std::size_t first = shared_.used.load(std::memory_order_relaxed);
       do {
@@ -598,14 +598,12 @@ private:
     return true;
   }
 
-  /** Put cell c on this builder's free list (dead to the others). */
+  /** Put cell c on this builder's stack of freed cells (dead to the others). */
   void
   freeCell(int c)
   {
     cells_[c].v[0] = BuildCell::FREE;
-    cells_[c].n[0] = static_cast<std::uint32_t>(free_);
-    free_ = c;
-    ++free_count_;
+    free_.push_back(c);
     letGo(c, SharedCells::DEAD);
   }
 
@@ -614,10 +612,9 @@ private:
   allocate()
   {
     int c;
-    if (free_ >= 0) {
-      c = free_;
-      free_ = static_cast<int>(cells_[c].n[0]);
-      --free_count_;
+    if (!free_.empty()) {
+      c = free_.back();
+      free_.pop_back();
     }
     else
       c = static_cast<int>(next_++);
@@ -779,8 +776,10 @@ private:
   /** Where the next walk starts. */
   int start_ = 0;
   /** This builder's freed cells, linked through n[0]. */
-  int free_ = -1;
-  std::size_t free_count_ = 0;
+  /** The freed cells, the latest last (in the cache, reused first): a stack of ids
+   * rather than a list through the cells, whose next link would be a load from a
+   * cell long out of the cache for each one taken. */
+  std::vector<int> free_;
   /** The cells of this builder's block not used yet. */
   std::size_t next_ = 0, end_ = 0;
 };
