@@ -46,6 +46,28 @@ TEST(UniquePoints, VertexIdsDoNotDependOnInputOrder)
   EXPECT_EQ(makeUniquePoints(a).points, makeUniquePoints(b).points);
 }
 
+TEST(UniquePoints, SameWithAnyThreadCount)
+{
+  // Enough points for the threads to sort parts, with duplicates, points that share
+  // a Morton code and non-finite ones.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> in(200000);
+  for (auto& p : in)
+    p = {coordinate(random), coordinate(random), coordinate(random)};
+  for (std::size_t i = 0; i < in.size(); i += 97)
+    in[i] = in[i / 2];
+  for (std::size_t i = 5; i < in.size(); i += 1001)
+    in[i] = in[i - 1] + Eigen::Vector3d(1e-12, 0.0, 0.0);
+  in[11].x() = std::numeric_limits<double>::quiet_NaN();
+  const UniquePoints alone = makeUniquePoints(in);
+  for (const int threads : {2, 3}) {
+    const UniquePoints u = makeUniquePoints(in, threads);
+    EXPECT_EQ(u.points, alone.points) << threads;
+    EXPECT_EQ(u.vertex_of_input, alone.vertex_of_input) << threads;
+  }
+}
+
 TEST(Triangulate, DimensionOfDegenerateInput)
 {
   EXPECT_EQ(triangulate({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}).dimension, 1);

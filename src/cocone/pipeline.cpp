@@ -154,7 +154,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   const auto id = [&](std::size_t i) {
     return ids.empty() ? static_cast<int>(i) : ids[i];
   };
-  UniquePoints unique = makeUniquePoints(points);
+  UniquePoints unique = makeUniquePoints(points, threads);
   std::vector<Eigen::Vector3d>().swap(points); // the unique points stand in for them
   result.vertex_of_input = std::move(unique.vertex_of_input);
   result.vertices = unique.points.size();

@@ -56,7 +56,7 @@ toEigen(const CGAL::Exact_predicates_exact_constructions_kernel::Point_3& p)
 } // namespace
 
 UniquePoints
-makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
+makeUniquePoints(const std::vector<Eigen::Vector3d>& input, int threads)
 {
   UniquePoints out;
   out.vertex_of_input.assign(input.size(), -1);
@@ -88,16 +88,22 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
     v = (v | v << 2) & 0x1249249249249249ULL;
     return v;
   };
-  std::vector<std::pair<std::uint64_t, int>> keys;
-  keys.reserve(finite.size());
-  for (const int i : finite) {
-    std::uint64_t code = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double t = (input[i][k] - lo[k]) / extent * 2097151.0;
-      code |= spread(static_cast<std::uint64_t>(std::clamp(t, 0.0, 2097151.0))) << k;
-    }
-    keys.emplace_back(code, i);
-  }
+  std::vector<std::pair<std::uint64_t, int>> keys(finite.size());
+  detail::forEachRange(
+      finite.size(),
+      detail::partsFor(finite.size(), threads),
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t j = begin; j < end; ++j) {
+          const int i = finite[j];
+          std::uint64_t code = 0;
+          for (int k = 0; k < 3; ++k) {
+            const double t = (input[i][k] - lo[k]) / extent * 2097151.0;
+            code |= spread(static_cast<std::uint64_t>(std::clamp(t, 0.0, 2097151.0)))
+                    << k;
+          }
+          keys[j] = {code, i};
+        }
+      });
   std::vector<int>().swap(finite);
   // By code: a radix sort, one stable counting sort a 16-bit digit, keeps the input
   // order within a code; the few runs of one code are then ordered by position.
@@ -108,7 +114,7 @@ makeUniquePoints(const std::vector<Eigen::Vector3d>& input)
       detail::countingSort(
           keys.size(),
           std::size_t(1) << DIGIT,
-          1,
+          threads,
           [&](std::size_t j) {
             return static_cast<std::size_t>((keys[j].first >> shift) &
                                             ((1u << DIGIT) - 1));

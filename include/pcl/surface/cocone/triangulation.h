@@ -31,9 +31,10 @@ struct UniquePoints {
   std::vector<int> vertex_of_input;
 };
 
-/** \brief Drop non-finite points and merge exact duplicates. */
+/** \brief Drop non-finite points and merge exact duplicates, with up to \a threads
+ * threads (the same result). */
 UniquePoints
-makeUniquePoints(const std::vector<Eigen::Vector3d>& input);
+makeUniquePoints(const std::vector<Eigen::Vector3d>& input, int threads = 1);
 
 namespace detail {
 struct DelaunayStructure;
