@@ -198,6 +198,32 @@ vertexFans(const std::vector<Triangle>& oriented,
         others.emplace_back(oriented[t][(k + 1) % 3], i);
         others.emplace_back(oriented[t][(k + 2) % 3], i);
       }
+      // Most stars are one fan: walked from the first triangle both ways, from one
+      // triangle to an unseen one that shares an edge at v, it takes them all.
+      const auto other = [&](int i, int side) {
+        return others[2 * static_cast<std::size_t>(i) + side].first;
+      };
+      std::uint32_t seen = 1;
+      int count = 1;
+      for (int side = 0; side < 2 && size <= SMALL_STAR; ++side)
+        for (int w = other(0, side);;) {
+          int next = 0;
+          while (next < size &&
+                 ((seen >> next & 1u) || (other(next, 0) != w && other(next, 1) != w)))
+            ++next;
+          if (next == size)
+            break;
+          seen |= 1u << next;
+          ++count;
+          w = other(next, 0) == w ? other(next, 1) : other(next, 0);
+        }
+      if (count == size) {
+        for (int i = 0; i < size; ++i)
+          fan[corners[first + i]] = 0;
+        if (fans_per_vertex)
+          (*fans_per_vertex)[v] = 1;
+        continue;
+      }
       if (size <= SMALL_STAR) {
         // A few triangles: compare every two, cheaper than sorting.
         for (int i = 1; i < size; ++i)
