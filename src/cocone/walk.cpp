@@ -148,18 +148,9 @@ walk(const TriangleComplex& complex,
       }
   }
   // Per edge its present triangles; per patch root whether it is twisted (a link
-  // whose parities disagree: a band with a half turn); per present triangle the
-  // edges (bit k: edge k) that the walk proper processes, of three or more
-  // candidate triangles.
+  // whose parities disagree: a band with a half turn).
   std::vector<int> edge_count(num_edges, 0);
-  std::vector<std::uint8_t> twisted(m, 0), crossing(m, 0);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-    for (int k = 0; present[t] && k < 3; ++k) {
-      const int e = complex.triangleEdges(static_cast<int>(t))[k];
-      if (complex.edgeEnd(e) - complex.edgeBegin(e) > 2)
-        crossing[t] |= static_cast<std::uint8_t>(1u << k);
-    }
+  std::vector<std::uint8_t> twisted(m, 0);
 #pragma omp parallel for num_threads(threads) schedule(static, 8192)
   for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
     for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i)
@@ -304,9 +295,11 @@ walk(const TriangleComplex& complex,
       if (marking)
         for (const int v : complex.triangle(s))
           used[v] = 1;
-      for (int k = 3; k-- > 0;)
-        if (crossing[s] >> k & 1u)
+      for (int k = 3; k-- > 0;) {
+        const int e = complex.triangleEdges(s)[k];
+        if (complex.edgeEnd(e) - complex.edgeBegin(e) > 2)
           pending.push_back({s, k});
+      }
     }
   };
   const auto walk_from = [&](int seed) {
