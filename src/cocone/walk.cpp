@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <utility>
 
@@ -94,101 +95,26 @@ walk(const TriangleComplex& complex,
      int threads)
 {
   const int m = static_cast<int>(complex.numTriangles());
-  const auto num_triangles = static_cast<std::ptrdiff_t>(m);
-  const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
   WalkResult out;
 
-  // At an edge of exactly two candidate triangles (99.6 % of them) the walk's choice
-  // does not depend on the way it arrives: it crosses to the other triangle if that
-  // one is present and the two make an angle above pi / 2 (a link), else nowhere.
-  // The triangles joined by links form patches, which a walk that reaches one of
-  // their triangles floods. They are found in parallel, by a union-find whose parity
-  // tells whether a triangle is turned relative to its patch's lowest triangle; a
-  // triangle's reference orientation is its vertices in ascending order, which runs
-  // the edge opposite its corner 1 downwards and the other two upwards. The walk
-  // proper then goes from patch to patch across the other edges, in the paper's way.
-  const auto is_link = [&](int e) {
-    const std::size_t i = complex.edgeBegin(e);
-    return complex.edgeEnd(e) - i == 2 && present[complex.edgeTriangle(i)] &&
-           present[complex.edgeTriangle(i + 1)] && !complex.acutePair(e);
-  };
-  const auto across_link = [&](int e, int t) {
-    const std::size_t i = complex.edgeBegin(e);
-    return complex.edgeTriangle(i) == t ? complex.edgeTriangle(i + 1)
-                                        : complex.edgeTriangle(i);
-  };
-  // Whether the link at edge e, edge k of a triangle, joins it to t2 turned against
-  // it: their reference orientations run e the same way.
-  const auto link_parity = [&](int k, int t2, int e) {
-    const auto& edges = complex.triangleEdges(t2);
-    const int k2 = edges[0] == e ? 0 : edges[1] == e ? 1 : 2;
-    return static_cast<int>((k == 1) == (k2 == 1));
-  };
-  std::vector<int> patch(m, -1);
-  std::vector<std::uint8_t> parity(m, 0);
-  {
-    detail::ConcurrentParitySets sets(m, threads);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-    for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
-      if (!present[t])
-        continue;
-      for (int k = 0; k < 3; ++k) {
-        const int e = complex.triangleEdges(static_cast<int>(t))[k];
-        const int t2 = across_link(e, static_cast<int>(t));
-        if (t2 > t && is_link(e))
-          sets.unite(static_cast<int>(t), t2, link_parity(k, t2, e));
-      }
-    }
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-    for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-      if (present[t]) {
-        const auto found = sets.find(static_cast<int>(t));
-        patch[t] = found.root;
-        parity[t] = static_cast<std::uint8_t>(found.parity);
-      }
-  }
-  // Per edge its present triangles; per patch root whether it is twisted (a link
-  // whose parities disagree: a band with a half turn).
+  // Connected components of the present triangles (through shared edges), by a
+  // union-find over the edges in parallel: a set's root is its lowest triangle.
+  const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
+  auto sets = std::make_unique<detail::ConcurrentParitySets>(m, threads);
   std::vector<int> edge_count(num_edges, 0);
-  std::vector<std::uint8_t> twisted(m, 0);
 #pragma omp parallel for num_threads(threads) schedule(static, 8192)
   for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
-    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i)
-      edge_count[e] += present[complex.edgeTriangle(i)];
-    if (!is_link(static_cast<int>(e)))
-      continue;
-    const int t = complex.edgeTriangle(complex.edgeBegin(e));
-    const int t2 = across_link(static_cast<int>(e), t);
-    const auto& edges = complex.triangleEdges(t);
-    const int k = edges[0] == e ? 0 : edges[1] == e ? 1 : 2;
-    if ((parity[t] ^ parity[t2]) != link_parity(k, t2, static_cast<int>(e)))
-      __atomic_store_n(&twisted[patch[t]], 1, __ATOMIC_RELAXED);
-  }
-
-  // The connected components of the present triangles through any shared edge: the
-  // patches joined across the edges that are not links.
-  std::vector<int> component(m, -1);
-  {
-    detail::ConcurrentParitySets sets(m, threads);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-    for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
-      if (edge_count[e] < 2 || is_link(static_cast<int>(e)))
+    int first = -1;
+    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+      const int t = complex.edgeTriangle(i);
+      if (!present[t])
         continue;
-      int first = -1;
-      for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
-        const int t = complex.edgeTriangle(i);
-        if (!present[t])
-          continue;
-        if (first < 0)
-          first = patch[t];
-        else
-          sets.unite(first, patch[t], 0);
-      }
+      ++edge_count[e];
+      if (first < 0)
+        first = t;
+      else
+        sets->unite(first, t, 0);
     }
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-    for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-      if (present[t])
-        component[t] = sets.find(patch[t]).root;
   }
   const auto score = [&](int t) {
     const auto& v = complex.triangle(t);
@@ -198,193 +124,122 @@ walk(const TriangleComplex& complex,
       manifold = manifold && edge_count[e] == 2;
     return 2 * umbrellas + manifold;
   };
-  // Per component (at its root, its lowest triangle) its seed: the best score, then
-  // the lowest triangle; the components in the order of their roots.
-  std::vector<int> seeds;
-  {
-    std::vector<std::uint64_t> best(m, 0);
+  // Per component (at its root) its seed: the best score, then the lowest triangle.
+  std::vector<std::uint64_t> best(m, 0);
 #pragma omp parallel for num_threads(threads) schedule(static, 8192)
-    for (std::ptrdiff_t t = 0; t < num_triangles; ++t) {
-      if (!present[t])
-        continue;
-      const std::uint64_t key = std::uint64_t(score(static_cast<int>(t)) + 1) << 32 |
-                                static_cast<std::uint32_t>(m - t);
-      std::uint64_t* target = &best[component[t]];
-      std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
-      while (key > seen &&
-             !__atomic_compare_exchange_n(
-                 target, &seen, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-      }
+  for (int t = 0; t < m; ++t) {
+    if (!present[t])
+      continue;
+    const std::uint64_t key =
+        std::uint64_t(score(t) + 1) << 32 | static_cast<std::uint32_t>(m - t);
+    std::uint64_t* target = &best[sets->find(t).root];
+    std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+    while (key > seen &&
+           !__atomic_compare_exchange_n(
+               target, &seen, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
     }
-    for (int t = 0; t < m; ++t)
-      if (present[t] && component[t] == t)
-        seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
   }
-  std::vector<int>().swap(component);
+  // The components in the order of their lowest triangles.
+  std::vector<int> seeds;
+  for (int t = 0; t < m; ++t)
+    if (present[t] && sets->find(t).root == t)
+      seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
+  std::vector<std::uint64_t>().swap(best);
+  sets.reset();
   out.components = seeds.size();
 
-  // Per patch its triangles in ascending order (those not present come first).
-  std::vector<int> members(m);
-  const std::vector<std::uint32_t> member_first = detail::countingSort(
-      static_cast<std::size_t>(m),
-      static_cast<std::size_t>(m) + 1,
-      threads,
-      [&](std::size_t t) {
-        return patch[t] < 0 ? std::size_t(0) : static_cast<std::size_t>(patch[t]) + 1;
-      },
-      [&](std::size_t t, std::uint32_t place) {
-        members[place] = static_cast<int>(t);
-      });
-  const auto patch_begin = [&](int root) { return member_first[root + 1]; };
-  const auto patch_end = [&](int root) { return member_first[root + 2]; };
-
-  // The walk proper, from patch to patch across the edges of three or more candidate
-  // triangles, each edge processed once. A triangle's orientation: its reference,
-  // turned over where its patch's turn (set as the walk enters the patch) differs
-  // from its parity; in a twisted patch its own turn, set by a breadth-first flood
-  // of the links from where the walk entered.
-  std::vector<std::uint8_t> entered(m, 0), turn(m, 0), reached, processed(num_edges, 0);
-  std::vector<std::uint8_t> used(complex.points().size(), 0);
-  std::vector<int> order; // the patches in the order entered
-  const auto oriented = [&](int t) {
-    Triangle v = complex.triangle(t);
-    if ((twisted[patch[t]] ? turn[t] : turn[patch[t]] ^ parity[t]) != 0)
-      std::swap(v[1], v[2]);
-    return v;
-  };
+  // The walk, as in the paper: every edge is processed once.
+  std::vector<std::uint8_t> processed(complex.numEdges(), 0);
+  std::vector<Triangle> oriented(m);
+  std::vector<std::uint8_t> in_surface(m, 0);
   struct Pending {
-    int t, k;
+    int x, y, t;
   };
   std::vector<Pending> pending;
-  std::vector<int> queue;
-  bool marking = false; // the vertices used are marked as the walk enters patches
-  const auto enter = [&](int t, bool t_turned) {
-    const int root = patch[t];
-    entered[root] = 1;
-    order.push_back(root);
-    if (!twisted[root])
-      turn[root] = static_cast<std::uint8_t>(t_turned ^ (parity[t] != 0));
-    else {
-      // A triangle reached again turned the other way is a conflict of the walk.
-      if (reached.empty())
-        reached.assign(m, 0);
-      queue.assign(1, t);
-      turn[t] = t_turned;
-      reached[t] = 1;
-      for (std::size_t q = 0; q < queue.size(); ++q) {
-        const int u = queue[q];
-        for (int k = 0; k < 3; ++k) {
-          const int e = complex.triangleEdges(u)[k];
-          if (!is_link(e))
-            continue;
-          const int u2 = across_link(e, u);
-          const int want = turn[u] ^ link_parity(k, u2, e);
-          if (reached[u2]) {
-            out.conflicts += u < u2 && turn[u2] != want;
-            continue;
-          }
-          reached[u2] = 1;
-          turn[u2] = static_cast<std::uint8_t>(want);
-          queue.push_back(u2);
-        }
-      }
-    }
-    // Its edges to process wait, to be taken in the order of the triangles.
-    for (std::uint32_t i = patch_end(root); i-- > patch_begin(root);) {
-      const int s = members[i];
-      if (marking)
-        for (const int v : complex.triangle(s))
-          used[v] = 1;
-      for (int k = 3; k-- > 0;) {
-        const int e = complex.triangleEdges(s)[k];
-        if (complex.edgeEnd(e) - complex.edgeBegin(e) > 2)
-          pending.push_back({s, k});
-      }
-    }
+  // After one walk per component, a walk from every present triangle none of whose
+  // vertices the surface uses yet: a component joined to another by stray
+  // candidate triangles that the walk does not cross still gets its own walk.
+  std::vector<std::uint8_t> used(complex.points().size(), 0);
+  const auto free = [&](int t) {
+    const auto& v = complex.triangle(t);
+    return !in_surface[t] && !used[v[0]] && !used[v[1]] && !used[v[2]];
   };
-  const auto walk_from = [&](int seed) {
-    enter(seed, false);
+  // Gathered once the component walks are done: a triangle not free then never
+  // becomes free (the surface and its vertices only grow), and mostly none is.
+  std::vector<int> reseeds;
+  bool gathered = false;
+  std::size_t next_component = 0, next_reseed = 0;
+  const auto next_seed = [&]() {
+    if (next_component < seeds.size())
+      return seeds[next_component++];
+    if (!gathered) {
+      gathered = true;
+      for (int t = 0; t < m; ++t)
+        if (present[t] && free(t))
+          reseeds.push_back(t);
+      std::stable_sort(reseeds.begin(), reseeds.end(), [&](int a, int b) {
+        return score(a) > score(b);
+      });
+    }
+    for (; next_reseed < reseeds.size(); ++next_reseed) {
+      const int t = reseeds[next_reseed];
+      if (free(t)) {
+        ++out.reseeds;
+        return t;
+      }
+    }
+    return -1;
+  };
+  for (int s = next_seed(); s >= 0; s = next_seed()) {
+    const auto& v = complex.triangle(s);
+    oriented[s] = v;
+    in_surface[s] = 1;
+    out.triangles.push_back(v);
+    out.ids.push_back(s);
+    used[v[0]] = used[v[1]] = used[v[2]] = 1;
+    pending = {{v[2], v[0], s}, {v[1], v[2], s}, {v[0], v[1], s}};
     while (!pending.empty()) {
       const Pending p = pending.back();
       pending.pop_back();
-      const int e = complex.triangleEdges(p.t)[p.k];
+      const auto& o = oriented[p.t];
+      const int z = o[0] + o[1] + o[2] - p.x - p.y;
+      const int e = edgeOpposite(complex, p.t, z);
       if (processed[e])
         continue;
       processed[e] = 1;
-      // The edge as p.t, oriented, runs it: x -> y, z the third vertex.
-      const Triangle o = oriented(p.t);
-      const int z = complex.triangle(p.t)[p.k];
-      const int i = o[0] == z ? 0 : o[1] == z ? 1 : 2;
-      const int x = o[(i + 1) % 3], y = o[(i + 2) % 3];
-      int a = -1;
-      const int t2 = neighborAcross(complex, present, p.t, e, x, y, z, a);
+      int a = -1, t2 = -1;
+      if (complex.edgeEnd(e) - complex.edgeBegin(e) == 2) {
+        // Most edges: the other triangle, taken where the two make an angle above
+        // pi / 2 (the complex knows), as neighborAcross() would take it.
+        const std::size_t i = complex.edgeBegin(e);
+        t2 = complex.edgeTriangle(i) == p.t ? complex.edgeTriangle(i + 1)
+                                            : complex.edgeTriangle(i);
+        if (!present[t2] || complex.acutePair(e))
+          continue;
+        const auto& v = complex.triangle(t2);
+        a = v[0] + v[1] + v[2] - p.x - p.y;
+      }
+      else
+        t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
       if (t2 < 0)
         continue;
-      if (entered[patch[t2]]) {
+      const Triangle next{p.y, p.x, a};
+      if (in_surface[t2]) {
         // Reached again: keep the first orientation, count a disagreement.
-        const Triangle q = oriented(t2);
+        const auto& q = oriented[t2];
         for (int k = 0; k < 3; ++k)
-          if (q[k] == x && q[(k + 1) % 3] == y)
+          if (q[k] == p.x && q[(k + 1) % 3] == p.y)
             ++out.conflicts;
         continue;
       }
-      // t2 oriented (y, x, a): turned unless that is a rotation of its reference.
-      const Triangle& r = complex.triangle(t2);
-      const int j = r[0] == y ? 0 : r[1] == y ? 1 : 2;
-      enter(t2, r[(j + 1) % 3] != x);
+      oriented[t2] = next;
+      in_surface[t2] = 1;
+      out.triangles.push_back(next);
+      out.ids.push_back(t2);
+      used[a] = 1;
+      pending.push_back({a, p.y, t2});
+      pending.push_back({p.x, a, t2});
     }
-  };
-  for (const int s : seeds)
-    walk_from(s);
-
-  // Then a walk from every present triangle none of whose vertices the surface uses
-  // yet: a component joined to another by stray candidate triangles that the walk
-  // does not cross still gets its own walk. A triangle not free now never becomes
-  // free (the surface and its vertices only grow), and mostly none is.
-  const auto in_surface = [&](int t) { return present[t] && entered[patch[t]]; };
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-  for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-    if (in_surface(static_cast<int>(t)))
-      for (const int v : complex.triangle(static_cast<int>(t)))
-        __atomic_store_n(&used[v], 1, __ATOMIC_RELAXED);
-  const auto free = [&](int t) {
-    const auto& v = complex.triangle(t);
-    return !in_surface(t) && !used[v[0]] && !used[v[1]] && !used[v[2]];
-  };
-  std::vector<int> reseeds;
-  for (int t = 0; t < m; ++t)
-    if (present[t] && free(t))
-      reseeds.push_back(t);
-  std::stable_sort(reseeds.begin(), reseeds.end(), [&](int a, int b) {
-    return score(a) > score(b);
-  });
-  marking = true;
-  for (const int t : reseeds)
-    if (free(t)) {
-      ++out.reseeds;
-      walk_from(t);
-    }
-
-  // The triangles of the patches in the order entered, each patch's in ascending
-  // order.
-  std::vector<std::uint32_t> offset(m, 0);
-  std::uint32_t total = 0;
-  for (const int root : order) {
-    offset[root] = total;
-    total += patch_end(root) - patch_begin(root);
-  }
-  out.triangles.resize(total);
-  out.ids.resize(total);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-  for (std::ptrdiff_t i = member_first[1]; i < num_triangles; ++i) {
-    const int t = members[i];
-    const int root = patch[t];
-    if (!entered[root])
-      continue;
-    const std::uint32_t at =
-        offset[root] + static_cast<std::uint32_t>(i) - patch_begin(root);
-    out.triangles[at] = oriented(t);
-    out.ids[at] = t;
   }
   return out;
 }

@@ -51,21 +51,10 @@ surfaceNeighbor(const TriangleComplex& complex,
  * again from every present triangle whose vertices no walk has reached (a component
  * joined to another only by stray triangles that the walk does not cross).
  *
- * At an edge of exactly two candidate triangles SURFACENEIGHBOR's answer does not
- * depend on the way the walk arrives (the other triangle if it is present and the
- * two make an angle above pi / 2, else none): the triangles joined so form patches
- * that a walk reaching one of their triangles takes whole, consistently oriented
- * (found in parallel). The walk goes from patch to patch across the other edges,
- * each processed once, a patch's edges in the order of its triangles, depth first;
- * a patch that cannot be oriented (a twisted band) is flooded breadth first from
- * where the walk entered it, a conflict where its fronts meet the other way round.
- * The triangles come out patch by patch, in the order the walk entered them.
- *
  * \param[in] complex the candidate triangles
  * \param[in] present per triangle: survived pruning
  * \param[in] boundary per vertex: B plus the umbrella failures
- * \param[in] threads threads to find the patches and components with (the same
- *            walk)
+ * \param[in] threads threads to find the components with (the same walk)
  */
 WalkResult
 walk(const TriangleComplex& complex,
