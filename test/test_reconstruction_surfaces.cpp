@@ -101,6 +101,24 @@ addBand(std::vector<Eigen::Vector3d>& P,
   }
 }
 
+/** Bands of 2 n triangles each (addBand()): an annulus about the origin, a Moebius
+ * strip beside it, then, with three, a second annulus around the first. */
+struct Bands {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<pcl::cocone::Triangle> triangles;
+};
+
+Bands
+bands(int n, int count)
+{
+  Bands b;
+  addBand(b.points, b.triangles, n, 0.0, 1.0, false);
+  addBand(b.points, b.triangles, n, 3.0, 1.0, true);
+  if (count > 2)
+    addBand(b.points, b.triangles, n, 0.0, 2.0, false);
+  return b;
+}
+
 using Generator = std::function<Sample(const SampleOptions&)>;
 
 struct ClosedCase {
@@ -492,10 +510,11 @@ TEST(Repair, IncidencesAddedRemovedAndThreadedAsIfGroupedAgain)
   expect_same(EdgeIncidences(large, 3), EdgeIncidences(large, 1));
 }
 
-TEST(Walk, IncidencesReadOffTheComplexAsIfGrouped)
+TEST(Walk, SameWalkAndIncidencesWithAnyThreadCount)
 {
   // The co-cone triangles of a noisy saddle, all present: edges with three and more
-  // triangles, of which the walk takes some; enough for three threads to read parts.
+  // triangles, of which the walk takes some; enough for three threads to find the
+  // components and read the incidences in parts.
   const auto s = cocone_test::monkeySaddle(options(70000, 0.1));
   auto unique = pcl::cocone::makeUniquePoints(s.points);
   const auto dt = pcl::cocone::triangulate(std::move(unique.points));
@@ -507,6 +526,14 @@ TEST(Walk, IncidencesReadOffTheComplexAsIfGrouped)
   const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
   const std::vector<std::uint8_t> boundary(dt.points.size(), 0);
   const auto walked = pcl::cocone::walk(complex, present, boundary);
+  for (const int threads : {2, 3}) {
+    const auto again = pcl::cocone::walk(complex, present, boundary, threads);
+    EXPECT_EQ(again.triangles, walked.triangles) << threads;
+    EXPECT_EQ(again.ids, walked.ids) << threads;
+    EXPECT_EQ(again.components, walked.components) << threads;
+    EXPECT_EQ(again.conflicts, walked.conflicts) << threads;
+    EXPECT_EQ(again.reseeds, walked.reseeds) << threads;
+  }
   ASSERT_EQ(walked.ids.size(), walked.triangles.size());
   ASSERT_GT(walked.triangles.size(), 10000u);
   ASSERT_LT(walked.triangles.size(), complex.numTriangles());
@@ -524,41 +551,13 @@ TEST(Walk, IncidencesReadOffTheComplexAsIfGrouped)
   }
 }
 
-TEST(Walk, SameWalkWithAnyThreadCount)
-{
-  // The co-cone triangles of a noisy saddle, all present: many patches of triangles
-  // joined by edges of two, and edges of three and more between them.
-  const auto s = cocone_test::monkeySaddle(options(70000, 0.1));
-  auto unique = pcl::cocone::makeUniquePoints(s.points);
-  const auto dt = pcl::cocone::triangulate(std::move(unique.points));
-  const auto cells = pcl::cocone::computeVoronoiCells(dt, 3.0 * M_PI / 8.0);
-  std::vector<pcl::cocone::Triangle> triangles;
-  for (const auto& t : cells.triangles)
-    triangles.push_back(t.v);
-  const pcl::cocone::TriangleComplex complex(dt.points, triangles);
-  const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
-  const std::vector<std::uint8_t> boundary(dt.points.size(), 0);
-  const auto alone = pcl::cocone::walk(complex, present, boundary, 1);
-  for (const int threads : {2, 3}) {
-    const auto walked = pcl::cocone::walk(complex, present, boundary, threads);
-    EXPECT_EQ(walked.triangles, alone.triangles) << threads;
-    EXPECT_EQ(walked.ids, alone.ids) << threads;
-    EXPECT_EQ(walked.components, alone.components) << threads;
-    EXPECT_EQ(walked.conflicts, alone.conflicts) << threads;
-    EXPECT_EQ(walked.reseeds, alone.reseeds) << threads;
-  }
-}
-
 TEST(Walk, TwistedBandHasOneConflict)
 {
   // An annulus and a Moebius strip of 3,000 triangles each, as candidates: the walk
   // takes every triangle, the annulus oriented alike throughout, the strip with one
   // edge where its orientations meet the other way round.
   const int n = 1500;
-  std::vector<Eigen::Vector3d> P;
-  std::vector<pcl::cocone::Triangle> mesh;
-  addBand(P, mesh, n, 0.0, 1.0, false);
-  addBand(P, mesh, n, 3.0, 1.0, true);
+  const auto [P, mesh] = bands(n, 2);
   const pcl::cocone::TriangleComplex complex(P, mesh);
   const std::vector<std::uint8_t> present(complex.numTriangles(), 1);
   const std::vector<std::uint8_t> boundary(P.size(), 0);
@@ -601,11 +600,7 @@ TEST(Repair, OrientsEachComponentWithAnyThreadCount)
   // annulus around it. The annuli come out consistent (each turned to its positive
   // volume), the strip cut once, the same with one thread or two.
   const int n = 12000;
-  std::vector<Eigen::Vector3d> P;
-  std::vector<pcl::cocone::Triangle> mesh;
-  addBand(P, mesh, n, 0.0, 1.0, false);
-  addBand(P, mesh, n, 3.0, 1.0, true);
-  addBand(P, mesh, n, 0.0, 2.0, false);
+  auto [P, mesh] = bands(n, 3);
   for (std::size_t t = 0; t < mesh.size(); t += 6) // every third of the annuli's
     if (t < 2 * n || t >= 4 * n)
       std::swap(mesh[t][1], mesh[t][2]);
