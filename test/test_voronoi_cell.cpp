@@ -73,6 +73,20 @@ TEST(IntersectCocone, SegmentCrossingTheBandWithBothEndsOutside)
   EXPECT_NEAR(hit.max_distance, std::sqrt(0.01 + z * z), 1e-12);
 }
 
+TEST(IntersectCocone, FarEndedSegmentFromItsNearEnd)
+{
+  // The Voronoi edge of a surface triangle between a cell inside (0.4 below p) and a
+  // flat cell whose circumcenter lies 39,000 above: it passes 0.001 beside p, through
+  // the co-cone for a few ten-thousandths. Followed from its near end (as the
+  // co-cone pass does), the crossing is found; from the far end (measured: missed),
+  // the quadratic's discriminant is a difference of terms 1e15 times its own size.
+  const Eigen::Vector3d near(1e-3, 0, -0.4), far(6e-3, 0, 39000.0);
+  const CoconeHit hit = intersectCocone(ORIGIN, Z, COS_COCONE, near, far - near, false);
+  EXPECT_TRUE(hit.meets);
+  EXPECT_GT(hit.max_distance, 1e-3);
+  EXPECT_LT(hit.max_distance, 1.2e-3);
+}
+
 TEST(IntersectCocone, SegmentEndingInsideTheBand)
 {
   const CoconeHit hit = intersectCocone(ORIGIN,

@@ -487,7 +487,7 @@ computeCocones(const Triangulation& dt,
               continue;
           }
           const auto f = detail::oppositeFacet(cell.v, i).ids;
-          Eigen::Vector3d a = cc, d;
+          Eigen::Vector3d a = cc, b, d;
           if (ray) {
             d = outwardNormal(P, f, cell.outwardSide(i));
             // An unbounded Voronoi edge going to the negative side puts
@@ -499,7 +499,7 @@ computeCocones(const Triangulation& dt,
           else {
             // Orient the segment canonically so the test is bitwise
             // reproducible.
-            Eigen::Vector3d b = other;
+            b = other;
             if (lexLess(b, a))
               std::swap(a, b);
             d = b - a;
@@ -514,8 +514,17 @@ computeCocones(const Triangulation& dt,
               ++j;
             if (!(test >> j & 1u))
               continue;
-            const CoconeHit hit =
-                intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
+            // A segment is followed from its end nearer to v (the first on a tie):
+            // where it crosses the co-cone near v, the far end of a flat cell's
+            // (thousands of spacings away) would drown the crossing in rounding.
+            const bool from_b =
+                !ray && (b - P[v]).squaredNorm() < (a - P[v]).squaredNorm();
+            const CoconeHit hit = intersectCocone(P[v],
+                                                  vc.pole[v],
+                                                  cos_angle,
+                                                  from_b ? b : a,
+                                                  from_b ? Eigen::Vector3d(-d) : d,
+                                                  ray);
             if (hit.meets) {
               meets |= static_cast<std::uint8_t>(1u << k);
               atomicMax(&width[v], hit.max_distance);
