@@ -241,6 +241,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
       result.boundary_indices.push_back(id(i));
   }
   std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
+  result.polygons.reserve(result.triangles.size());
   for (const auto& t : result.triangles)
     result.polygons.push_back({result.representative[t[0]],
                                result.representative[t[1]],
@@ -248,7 +249,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   for (auto& loop : result.border_loops)
     for (auto& v : loop)
       v = result.representative[v];
-  result.positions = dt.points;
+  result.positions = std::move(dt.points); // the triangulation's last use
   return result;
 }
 
