@@ -222,6 +222,14 @@ intersectCocone(const Eigen::Vector3d& p,
                 const Eigen::Vector3d& d,
                 bool ray)
 {
+  // A segment is followed from its end nearer to p (a on a tie): where it crosses
+  // the co-cone near p, a far end (a flat cell's circumcenter lies thousands of
+  // spacings away) would drown the crossing in the quadratic's rounding.
+  if (!ray) {
+    const Eigen::Vector3d b = a + d;
+    if ((b - p).squaredNorm() < (a - p).squaredNorm())
+      return intersectCocone(p, pole, cos_angle, b, -d, false);
+  }
   // f(t) = ((y - p).u)^2 - c^2 |y - p|^2 <= 0 with y = a + t d.
   const Eigen::Vector3d e = a - p;
   const double c2 = cos_angle * cos_angle;
@@ -487,7 +495,7 @@ computeCocones(const Triangulation& dt,
               continue;
           }
           const auto f = detail::oppositeFacet(cell.v, i).ids;
-          Eigen::Vector3d a = cc, b, d;
+          Eigen::Vector3d a = cc, d;
           if (ray) {
             d = outwardNormal(P, f, cell.outwardSide(i));
             // An unbounded Voronoi edge going to the negative side puts
@@ -499,7 +507,7 @@ computeCocones(const Triangulation& dt,
           else {
             // Orient the segment canonically so the test is bitwise
             // reproducible.
-            b = other;
+            Eigen::Vector3d b = other;
             if (lexLess(b, a))
               std::swap(a, b);
             d = b - a;
@@ -514,17 +522,8 @@ computeCocones(const Triangulation& dt,
               ++j;
             if (!(test >> j & 1u))
               continue;
-            // A segment is followed from its end nearer to v (the first on a tie):
-            // where it crosses the co-cone near v, the far end of a flat cell's
-            // (thousands of spacings away) would drown the crossing in rounding.
-            const bool from_b =
-                !ray && (b - P[v]).squaredNorm() < (a - P[v]).squaredNorm();
-            const CoconeHit hit = intersectCocone(P[v],
-                                                  vc.pole[v],
-                                                  cos_angle,
-                                                  from_b ? b : a,
-                                                  from_b ? Eigen::Vector3d(-d) : d,
-                                                  ray);
+            const CoconeHit hit =
+                intersectCocone(P[v], vc.pole[v], cos_angle, a, d, ray);
             if (hit.meets) {
               meets |= static_cast<std::uint8_t>(1u << k);
               atomicMax(&width[v], hit.max_distance);

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <memory>
 #include <numeric>
 #include <utility>
 
@@ -41,6 +40,18 @@ neighborAcross(const TriangleComplex& complex,
                int z,
                int& apex)
 {
+  if (complex.edgeEnd(e) - complex.edgeBegin(e) == 2) {
+    // Most edges: the other triangle, where it is present and the two make an angle
+    // above pi / 2 (the complex knows); no frame, no rotation.
+    const std::size_t i = complex.edgeBegin(e);
+    const int t2 = complex.edgeTriangle(i) == t ? complex.edgeTriangle(i + 1)
+                                                : complex.edgeTriangle(i);
+    if (!present[t2] || complex.acutePair(e))
+      return -1;
+    const auto& v = complex.triangle(t2);
+    apex = v[0] + v[1] + v[2] - x - y;
+    return t2;
+  }
   const auto& P = complex.points();
   // Frame of the edge: u in t's plane towards z, n along t's normal.
   const Eigen::Vector3d d = (P[y] - P[x]).normalized();
@@ -100,22 +111,7 @@ walk(const TriangleComplex& complex,
   // Connected components of the present triangles (through shared edges), by a
   // union-find over the edges in parallel: a set's root is its lowest triangle.
   const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
-  auto sets = std::make_unique<detail::ConcurrentParitySets>(m, threads);
   std::vector<int> edge_count(num_edges, 0);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-  for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
-    int first = -1;
-    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
-      const int t = complex.edgeTriangle(i);
-      if (!present[t])
-        continue;
-      ++edge_count[e];
-      if (first < 0)
-        first = t;
-      else
-        sets->unite(first, t, 0);
-    }
-  }
   const auto score = [&](int t) {
     const auto& v = complex.triangle(t);
     const bool umbrellas = !boundary[v[0]] && !boundary[v[1]] && !boundary[v[2]];
@@ -124,28 +120,43 @@ walk(const TriangleComplex& complex,
       manifold = manifold && edge_count[e] == 2;
     return 2 * umbrellas + manifold;
   };
-  // Per component (at its root) its seed: the best score, then the lowest triangle.
-  std::vector<std::uint64_t> best(m, 0);
-#pragma omp parallel for num_threads(threads) schedule(static, 8192)
-  for (int t = 0; t < m; ++t) {
-    if (!present[t])
-      continue;
-    const std::uint64_t key =
-        std::uint64_t(score(t) + 1) << 32 | static_cast<std::uint32_t>(m - t);
-    std::uint64_t* target = &best[sets->find(t).root];
-    std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
-    while (key > seen &&
-           !__atomic_compare_exchange_n(
-               target, &seen, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-    }
-  }
-  // The components in the order of their lowest triangles.
   std::vector<int> seeds;
-  for (int t = 0; t < m; ++t)
-    if (present[t] && sets->find(t).root == t)
-      seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
-  std::vector<std::uint64_t>().swap(best);
-  sets.reset();
+  {
+    detail::ConcurrentParitySets sets(m, threads);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+    for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
+      int first = -1;
+      for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+        const int t = complex.edgeTriangle(i);
+        if (!present[t])
+          continue;
+        ++edge_count[e];
+        if (first < 0)
+          first = t;
+        else
+          sets.unite(first, t, 0);
+      }
+    }
+    // Per component (at its root) its seed: the best score, then the lowest triangle.
+    std::vector<std::uint64_t> best(m, 0);
+#pragma omp parallel for num_threads(threads) schedule(static, 8192)
+    for (int t = 0; t < m; ++t) {
+      if (!present[t])
+        continue;
+      const std::uint64_t key =
+          std::uint64_t(score(t) + 1) << 32 | static_cast<std::uint32_t>(m - t);
+      std::uint64_t* target = &best[sets.find(t).root];
+      std::uint64_t seen = __atomic_load_n(target, __ATOMIC_RELAXED);
+      while (key > seen &&
+             !__atomic_compare_exchange_n(
+                 target, &seen, key, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+      }
+    }
+    // The components in the order of their lowest triangles.
+    for (int t = 0; t < m; ++t)
+      if (present[t] && sets.find(t).root == t)
+        seeds.push_back(m - static_cast<int>(best[t] & 0xffffffffu));
+  }
   out.components = seeds.size();
 
   // The walk, as in the paper: every edge is processed once.
@@ -207,20 +218,8 @@ walk(const TriangleComplex& complex,
       if (processed[e])
         continue;
       processed[e] = 1;
-      int a = -1, t2 = -1;
-      if (complex.edgeEnd(e) - complex.edgeBegin(e) == 2) {
-        // Most edges: the other triangle, taken where the two make an angle above
-        // pi / 2 (the complex knows), as neighborAcross() would take it.
-        const std::size_t i = complex.edgeBegin(e);
-        t2 = complex.edgeTriangle(i) == p.t ? complex.edgeTriangle(i + 1)
-                                            : complex.edgeTriangle(i);
-        if (!present[t2] || complex.acutePair(e))
-          continue;
-        const auto& v = complex.triangle(t2);
-        a = v[0] + v[1] + v[2] - p.x - p.y;
-      }
-      else
-        t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
+      int a = -1;
+      const int t2 = neighborAcross(complex, present, p.t, e, p.x, p.y, z, a);
       if (t2 < 0)
         continue;
       const Triangle next{p.y, p.x, a};

@@ -81,7 +81,9 @@ struct CoconeHit {
  * The co-cone of p is {y : |cos angle(y - p, pole)| <= cos_angle}. Along the edge
  * y(t) = a + t d, with t in [0, 1] for a segment and t in [0, inf) for a ray, the
  * condition is a quadratic inequality in t, solved here: an edge may cross the
- * co-cone between two end points that both lie outside it.
+ * co-cone between two end points that both lie outside it. A segment is solved from
+ * its end nearer to p: from a far end (a flat cell's circumcenter) the crossing near
+ * p would be lost in rounding.
  *
  * \param[in] p the sample point
  * \param[in] pole unit pole direction of p
