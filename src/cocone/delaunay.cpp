@@ -775,7 +775,6 @@ private:
   std::uint32_t random_ = 12345;
   /** Where the next walk starts. */
   int start_ = 0;
-  /** This builder's freed cells, linked through n[0]. */
   /** The freed cells, the latest last (in the cache, reused first): a stack of ids
    * rather than a list through the cells, whose next link would be a load from a
    * cell long out of the cache for each one taken. */

@@ -31,19 +31,13 @@ wholeStar(const TriangleComplex& complex, int p)
   return first != last;
 }
 
-} // namespace
-
+/** HASUMBRELLA's cascade from the sharp edges at p; no triangle, no umbrella. */
 bool
-hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* kept)
+cascade(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* kept)
 {
   const std::size_t first = complex.vertexBegin(p), last = complex.vertexEnd(p);
   if (first == last)
     return false;
-  if (wholeStar(complex, p)) {
-    for (std::size_t i = first; kept && i < last; ++i)
-      __atomic_fetch_add(&(*kept)[complex.vertexTriangle(i)], 1, __ATOMIC_RELAXED);
-    return true;
-  }
   // Every triangle at an edge pq contains p: the star is all the cascade can touch.
   // (The incidence list of a vertex is in ascending triangle order.)
   thread_local std::vector<int> star;
@@ -94,6 +88,18 @@ hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* ke
   return true;
 }
 
+} // namespace
+
+bool
+hasUmbrella(const TriangleComplex& complex, int p, std::vector<std::uint8_t>* kept)
+{
+  if (!wholeStar(complex, p))
+    return cascade(complex, p, kept);
+  for (std::size_t i = complex.vertexBegin(p); kept && i < complex.vertexEnd(p); ++i)
+    __atomic_fetch_add(&(*kept)[complex.vertexTriangle(i)], 1, __ATOMIC_RELAXED);
+  return true;
+}
+
 std::vector<std::uint8_t>
 umbrellaFailures(const TriangleComplex& complex,
                  const std::vector<std::uint8_t>& boundary,
@@ -114,8 +120,8 @@ umbrellaFailures(const TriangleComplex& complex,
     if (wholeStar(complex, static_cast<int>(p)))
       whole[p] = 1;
     else
-      failed[p] = !hasUmbrella(
-          complex, static_cast<int>(p), umbrella_triangles ? &kept : nullptr);
+      failed[p] =
+          !cascade(complex, static_cast<int>(p), umbrella_triangles ? &kept : nullptr);
   }
   if (umbrella_triangles) {
     umbrella_triangles->resize(complex.numTriangles());
