@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <new>
@@ -337,6 +338,51 @@ private:
     return Kernel::Compare_xyz_3()(*a, *b) == CGAL::SMALLER;
   }
 
+  /** CGAL's semi-static filter of Side_of_oriented_sphere_3 (the same determinant,
+   * the same error bound) with its maxima taken without branches: +1 or -1 where the
+   * bound decides the sign, 0 where only CGAL's predicate can. */
+  static int
+  quickSideOfOrientedSphere(
+      const Point& p, const Point& q, const Point& r, const Point& s, const Point& t)
+  {
+    const double ptx = p.x() - t.x(), pty = p.y() - t.y(), ptz = p.z() - t.z();
+    const double qtx = q.x() - t.x(), qty = q.y() - t.y(), qtz = q.z() - t.z();
+    const double rtx = r.x() - t.x(), rty = r.y() - t.y(), rtz = r.z() - t.z();
+    const double stx = s.x() - t.x(), sty = s.y() - t.y(), stz = s.z() - t.z();
+    const double pt2 = ptx * ptx + pty * pty + ptz * ptz;
+    const double qt2 = qtx * qtx + qty * qty + qtz * qtz;
+    const double rt2 = rtx * rtx + rty * rty + rtz * rtz;
+    const double st2 = stx * stx + sty * sty + stz * stz;
+    const auto max4 = [](double a, double b, double c, double d) {
+      return std::max(std::max(std::abs(a), std::abs(b)),
+                      std::max(std::abs(c), std::abs(d)));
+    };
+    const double maxx = max4(ptx, qtx, rtx, stx);
+    const double maxy = max4(pty, qty, rty, sty);
+    const double maxz = max4(ptz, qtz, rtz, stz);
+    const double lo = std::min(std::min(maxx, maxy), maxz);
+    const double hi = std::max(std::max(maxx, maxy), maxz);
+    // Outside CGAL's range against underflow and overflow: its predicate decides.
+    if (!(lo >= 1e-58 && hi < 1e61))
+      return 0;
+    const double eps = 1.2466136531027298e-13 * maxx * maxy * maxz * (hi * hi);
+    // CGAL::determinant's expansion by 2x2 and 3x3 minors, operation for operation
+    // (the bound is for its rounding), of the rows pt, rt, qt, st; spelled out to
+    // be inlined.
+    const double m01 = rtx * pty - ptx * rty;
+    const double m02 = qtx * pty - ptx * qty;
+    const double m03 = stx * pty - ptx * sty;
+    const double m12 = qtx * rty - rtx * qty;
+    const double m13 = stx * rty - rtx * sty;
+    const double m23 = stx * qty - qtx * sty;
+    const double m012 = m12 * ptz - m02 * rtz + m01 * qtz;
+    const double m013 = m13 * ptz - m03 * rtz + m01 * stz;
+    const double m023 = m23 * ptz - m03 * qtz + m02 * stz;
+    const double m123 = m23 * rtz - m13 * qtz + m12 * stz;
+    const double det = m123 * pt2 - m023 * rt2 + m013 * qt2 - m012 * st2;
+    return det > eps ? 1 : det < -eps ? -1 : 0;
+  }
+
   /** CGAL's Delaunay_triangulation_3::side_of_oriented_sphere with its symbolic
    * perturbation, for a positively oriented cell: > 0 inside. */
   int
@@ -346,6 +392,9 @@ private:
                        const Point& p3,
                        const Point& p) const
   {
+    const int quick = quickSideOfOrientedSphere(p0, p1, p2, p3, p);
+    if (quick != 0)
+      return quick;
     const auto side = Kernel::Side_of_oriented_sphere_3()(p0, p1, p2, p3, p);
     if (side != CGAL::ON_ORIENTED_BOUNDARY)
       return side;
