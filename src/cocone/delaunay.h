@@ -76,7 +76,8 @@ infiniteCorner(const std::array<int, 4>& v)
 }
 
 /** \brief The Delaunay triangulation of points in general position in space, by
- * Bowyer-Watson insertion in CGAL's spatial order (Hilbert curve, random rounds).
+ * Bowyer-Watson insertion in random rounds (a biased randomized insertion order),
+ * each round by id.
  *
  * Every decision is CGAL's filtered exact predicate with CGAL's symbolic
  * perturbation of co-spherical and co-circular points, so the cells are those of
@@ -84,13 +85,15 @@ infiniteCorner(const std::array<int, 4>& v)
  * perturbation. Kept in two 16-byte arrays per cell instead of CGAL's linked cells,
  * which halves its memory and lets the passes read cells by index.
  *
- * With several threads, the points after the first eighth (CGAL's last round,
- * along one Hilbert curve) are cut into one stretch of the curve per thread, a part
- * of space each, and inserted at once; a thread holds every cell it reads, and an
- * insertion that meets a cell held by another thread is left for the end, when one
- * thread inserts what is left. The triangulation is unique, so the cells are the
- * same whatever the thread count (their order in \a cells is not).
- * \param[in] points unique points
+ * With several threads, the points after the first eighth (the last round) are
+ * cut into one stretch of ids per thread, a part of space each (makeUniquePoints
+ * numbers the points along a Morton curve), and inserted at once; a thread holds
+ * every cell it reads, and an insertion that meets a cell held by another thread is
+ * left for the end, when one thread inserts what is left. The triangulation is
+ * unique, so the cells are the same whatever the thread count (their order in
+ * \a cells is not).
+ * \param[in] points unique points; numbered along a space-filling curve (as
+ *            makeUniquePoints numbers them), or the insertion's walks grow long
  * \param[out] cells the cells, finite and infinite, and freed ones (v[0] == FREE)
  * \param[in] threads threads to insert with
  * \return the affine dimension of the points: below 3 the cells are left empty

@@ -73,14 +73,15 @@ struct Triangulation {
 
 /** \brief Triangulate unique points (stage 1).
  *
- * Points in space are inserted one by one in CGAL's spatial order (Bowyer-Watson;
- * with several threads, each in its own part of space); every decision is one of
- * CGAL's filtered exact predicates, with CGAL's symbolic perturbation of co-spherical
- * points, so the cells are exactly those of CGAL's Delaunay_triangulation_3 (the
- * Delaunay triangulation is unique under that perturbation). Coplanar points are
- * triangulated by CGAL.
- * \param[in] points unique points (see makeUniquePoints); vertex v of the result
- *            is points[v]. Taken by value: move them in and they become the
+ * Points in space are inserted one by one in random rounds, each along the ids
+ * (Bowyer-Watson; with several threads, each in its own part of space); every
+ * decision is one of CGAL's filtered exact predicates, with CGAL's symbolic
+ * perturbation of co-spherical points, so the cells are exactly those of CGAL's
+ * Delaunay_triangulation_3 (the Delaunay triangulation is unique under that
+ * perturbation). Coplanar points are triangulated by CGAL.
+ * \param[in] points unique points (see makeUniquePoints, whose numbering along a
+ *            Morton curve keeps the insertion's walks short); vertex v of the
+ *            result is points[v]. Taken by value: move them in and they become the
  *            result's recentred points without a copy.
  * \param[in] threads threads to insert the points with: the same cells whatever
  *            their number
