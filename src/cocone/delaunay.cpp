@@ -379,6 +379,42 @@ private:
     return det > eps ? 1 : det < -eps ? -1 : 0;
   }
 
+  /** CGAL's semi-static filter of Orientation_3 in the same way: +1 or -1 where its
+   * bound decides the sign of the orientation of p, q, r, s, 0 where only CGAL's
+   * predicate can. */
+  static int
+  quickOrientation(const Point& p, const Point& q, const Point& r, const Point& s)
+  {
+    const double pqx = q.x() - p.x(), pqy = q.y() - p.y(), pqz = q.z() - p.z();
+    const double prx = r.x() - p.x(), pry = r.y() - p.y(), prz = r.z() - p.z();
+    const double psx = s.x() - p.x(), psy = s.y() - p.y(), psz = s.z() - p.z();
+    const auto max3 = [](double a, double b, double c) {
+      return std::max(std::max(std::abs(a), std::abs(b)), std::abs(c));
+    };
+    const double maxx = max3(pqx, prx, psx);
+    const double maxy = max3(pqy, pry, psy);
+    const double maxz = max3(pqz, prz, psz);
+    const double lo = std::min(std::min(maxx, maxy), maxz);
+    const double hi = std::max(std::max(maxx, maxy), maxz);
+    if (!(lo >= 1e-97 && hi < 1e102))
+      return 0;
+    const double eps = 5.1107127829973299e-15 * maxx * maxy * maxz;
+    // CGAL::determinant's expansion of the rows pq, pr, ps, operation for operation.
+    const double m01 = pqx * pry - prx * pqy;
+    const double m02 = pqx * psy - psx * pqy;
+    const double m12 = prx * psy - psx * pry;
+    const double det = m01 * psz - m02 * prz + m12 * pqz;
+    return det > eps ? 1 : det < -eps ? -1 : 0;
+  }
+
+  /** Orientation_3 with the filter above inlined: > 0 positive. */
+  static int
+  orientationSign(const Point& p, const Point& q, const Point& r, const Point& s)
+  {
+    const int quick = quickOrientation(p, q, r, s);
+    return quick != 0 ? quick : Kernel::Orientation_3()(p, q, r, s);
+  }
+
   /** CGAL's Delaunay_triangulation_3::side_of_oriented_sphere with its symbolic
    * perturbation, for a positively oriented cell: > 0 inside. */
   int
@@ -456,9 +492,9 @@ private:
     // The finite facet, the infinite vertex on its positive side.
     const auto& f = FACET[i3];
     const Point &a = point(v[f[0]]), &b = point(v[f[1]]), &c = point(v[f[2]]);
-    const auto o = Kernel::Orientation_3()(a, b, c, p);
-    if (o != CGAL::COPLANAR)
-      return o == CGAL::POSITIVE;
+    const int o = orientationSign(a, b, c, p);
+    if (o != 0)
+      return o > 0;
     return coplanarSideOfBoundedCircle(a, b, c, p) > 0;
   }
 
@@ -477,7 +513,6 @@ private:
     int c = roughWalk(p, start_);
     if (c < 0)
       return -1;
-    const Kernel::Orientation_3 orientation;
     int previous = -1;
     for (;;) {
       const BuildCell& cell = cells_[c];
@@ -491,7 +526,7 @@ private:
       }
       else {
         next = step(cell, p, previous, [&](const auto& q) {
-          return orientation(*q[0], *q[1], *q[2], *q[3]) == CGAL::NEGATIVE;
+          return orientationSign(*q[0], *q[1], *q[2], *q[3]) < 0;
         });
         if (next < 0)
           return c;
