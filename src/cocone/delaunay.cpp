@@ -126,17 +126,16 @@ public:
         letGo(first);
         return true;
       }
-    stack_.clear();
     conflict_.clear();
     touched_.clear();
     boundary_.clear();
     prefetchNeighbors(first);
-    stack_.push_back(first);
     conflict_.push_back(first);
     mark(first, IN_CONFLICT);
-    while (!stack_.empty()) {
-      const int c = stack_.back();
-      stack_.pop_back();
+    // Breadth first, the conflict cells in the order found: a cell's neighbours
+    // are fetched when it is found and read only after the cells found before it.
+    for (std::size_t next = 0; next < conflict_.size(); ++next) {
+      const int c = conflict_[next];
       for (int i = 0; i < 4; ++i) {
         const std::uint32_t across = cells_[c].n[i];
         const int other = static_cast<int>(across >> 2);
@@ -149,7 +148,6 @@ public:
           if (inConflict(cells_[other].v, p)) {
             mark(other, IN_CONFLICT);
             prefetchNeighbors(other);
-            stack_.push_back(other);
             conflict_.push_back(other);
             continue;
           }
@@ -834,7 +832,7 @@ private:
   /** This builder's tag in the cells' states. */
   const std::uint8_t tag_;
   bool concurrent_;
-  std::vector<int> stack_, conflict_, touched_;
+  std::vector<int> conflict_, touched_;
   /** The cells made by the latest insertion. */
   std::vector<int> star_;
   std::vector<BoundaryFacet> boundary_;
