@@ -68,7 +68,8 @@ forEachRange(std::size_t count, int parts, const Body& body)
  * constraints agree, do not depend on the order of the unions. */
 class ConcurrentParitySets {
 public:
-  explicit ConcurrentParitySets(std::size_t n, int threads) : link_(n)
+  explicit ConcurrentParitySets(std::size_t n, int threads)
+  : link_(n), concurrent_(threads > 1)
   {
     const auto count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel for num_threads(threads) schedule(static, 65536)
@@ -117,6 +118,10 @@ public:
       std::uint64_t expected = static_cast<std::uint64_t>(y.root) << 1;
       const std::uint64_t below = static_cast<std::uint64_t>(x.root) << 1 |
                                   static_cast<std::uint64_t>(x.parity ^ y.parity ^ odd);
+      if (!concurrent_) { // no locked instruction where no other thread links
+        link_[y.root] = below;
+        return;
+      }
       if (__atomic_compare_exchange_n(
               &link_[y.root], &expected, below, false, RELAXED, RELAXED))
         return;
@@ -133,6 +138,7 @@ private:
   }
 
   std::vector<std::uint64_t> link_;
+  bool concurrent_;
 };
 
 } // namespace detail
