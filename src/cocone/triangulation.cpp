@@ -335,28 +335,42 @@ cornersOf(const Triangulation& dt)
   return dt.dimension == 3 ? 4 : 3;
 }
 
-/** The circumcenters of the finite cells, from their vertices in ascending id
- * order (a canonical order: the result is bitwise reproducible). */
+/** Room for the circumcenters of the finite cells, in the built cells' memory
+ * (trivial objects: reusing it ends their lifetime). */
+Eigen::Vector3d*
+placeCircumcenters(detail::DelaunayStructure& s)
+{
+  s.build.clear();
+  s.build.reserve(circumcenterCells(s.finite));
+  auto* circumcenters = reinterpret_cast<Eigen::Vector3d*>(s.build.data());
+  std::uninitialized_default_construct_n(circumcenters, s.finite);
+  return circumcenters;
+}
+
+/** The circumcenter of finite cell k, from its vertices in ascending id order (a
+ * canonical order: the result is bitwise reproducible). */
+Eigen::Vector3d
+circumcenterOf(const Triangulation& dt, int corners, std::size_t k)
+{
+  std::array<int, 4> v = dt.structure->vertices[k];
+  detail::sortCorners(v, corners, [](int id) { return id; });
+  const auto& P = dt.points;
+  return corners == 4 ? tetrahedronCircumcenter(P[v[0]], P[v[1]], P[v[2]], P[v[3]])
+                      : triangleCircumcenter(P[v[0]], P[v[1]], P[v[2]]);
+}
+
+/** The circumcenters of the finite cells, for a pass that reads its neighbours'. */
 void
 computeCircumcenters(const Triangulation& dt, int threads)
 {
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
-  // Into the built cells' memory (trivial objects: reusing it ends their lifetime).
-  s.build.clear();
-  s.build.reserve(circumcenterCells(s.finite));
-  s.circumcenters = reinterpret_cast<Eigen::Vector3d*>(s.build.data());
-  std::uninitialized_default_construct_n(s.circumcenters, s.finite);
+  Eigen::Vector3d* circumcenters = placeCircumcenters(s);
   detail::forEachRange(s.finite, threads, [&](std::size_t begin, std::size_t end, int) {
-    for (std::size_t k = begin; k < end; ++k) {
-      std::array<int, 4> v = s.vertices[k];
-      detail::sortCorners(v, corners, [](int id) { return id; });
-      const auto& P = dt.points;
-      s.circumcenters[k] =
-          corners == 4 ? tetrahedronCircumcenter(P[v[0]], P[v[1]], P[v[2]], P[v[3]])
-                       : triangleCircumcenter(P[v[0]], P[v[1]], P[v[2]]);
-    }
+    for (std::size_t k = begin; k < end; ++k)
+      circumcenters[k] = circumcenterOf(dt, corners, k);
   });
+  s.circumcenters = circumcenters;
 }
 
 } // namespace
@@ -465,8 +479,15 @@ visitCells(const Triangulation& dt,
   auto& s = *dt.structure;
   const int corners = cornersOf(dt);
   const bool neighbors = (data & CellView::NEIGHBORS) == CellView::NEIGHBORS;
-  if (((data & CellView::CIRCUMCENTER) || neighbors) && !s.circumcenters)
-    computeCircumcenters(dt, threads);
+  // The first pass that asks for the circumcenters computes each as it visits its
+  // cell (one pass over the cells less), unless it reads the neighbours' too.
+  Eigen::Vector3d* computing = nullptr;
+  if (((data & CellView::CIRCUMCENTER) || neighbors) && !s.circumcenters) {
+    if (neighbors)
+      computeCircumcenters(dt, threads);
+    else
+      computing = placeCircumcenters(s);
+  }
   const int finite = static_cast<int>(s.finite);
   detail::forEachRange(
       s.finite, threads, [&](std::size_t begin, std::size_t end, int thread) {
@@ -487,7 +508,9 @@ visitCells(const Triangulation& dt,
                   __builtin_prefetch(&s.circumcenters[other]);
               }
           }
-          if (data & CellView::CIRCUMCENTER)
+          if (computing)
+            view.circumcenter = computing[k] = circumcenterOf(dt, corners, k);
+          else if (data & CellView::CIRCUMCENTER)
             view.circumcenter = s.circumcenters[k];
           view.edges = 0;
           // The neighbours about an edge lie across the facets opposite the other two
@@ -512,6 +535,9 @@ visitCells(const Triangulation& dt,
           visitor(context, view, thread);
         }
       });
+  // Only once every cell has its circumcenter (forEachRange rethrows a failure).
+  if (computing)
+    s.circumcenters = computing;
 }
 
 } // namespace detail
