@@ -126,37 +126,58 @@ public:
         letGo(first);
         return true;
       }
-    conflict_.clear();
-    touched_.clear();
-    boundary_.clear();
     prefetchNeighbors(first);
-    conflict_.push_back(first);
     mark(first, IN_CONFLICT);
     // Breadth first, the conflict cells in the order found: a cell's neighbours
     // are fetched when it is found and read only after the cells found before it.
-    for (std::size_t next = 0; next < conflict_.size(); ++next) {
+    // Without a branch on a test's outcome, which is a coin flip to the branch
+    // predictor (a surface sample's conflict regions are large, some 30 cells with
+    // as many tested around them): a tested cell is written to both lists, and the
+    // one it belongs to grows; so is each facet to the boundary.
+    std::size_t found = 0, outside = 0, facets = 0;
+    const auto room = [](auto& list, std::size_t used) {
+      if (list.size() < used + 4)
+        list.resize(std::max(2 * list.size(), used + 4));
+    };
+    room(conflict_, 0);
+    conflict_[found++] = first;
+    for (std::size_t next = 0; next < found; ++next) {
+      room(conflict_, found);
+      room(touched_, outside);
+      room(boundary_, facets);
       const int c = conflict_[next];
+      const BuildCell& cell = cells_[c];
       for (int i = 0; i < 4; ++i) {
-        const std::uint32_t across = cells_[c].n[i];
+        const std::uint32_t across = cell.n[i];
         const int other = static_cast<int>(across >> 2);
         const std::uint8_t seen = stateOf(other);
-        if (seen == (tag_ | IN_CONFLICT))
-          continue;
-        if (seen != (tag_ | OUTSIDE)) {
-          if (!take(other, OUTSIDE))
+        bool border = seen == (tag_ | OUTSIDE);
+        if (!border && seen != (tag_ | IN_CONFLICT)) {
+          if (!take(other, OUTSIDE)) {
+            conflict_.resize(found);
+            touched_.resize(outside);
             return abandon();
-          if (inConflict(cells_[other].v, p)) {
-            mark(other, IN_CONFLICT);
-            prefetchNeighbors(other);
-            conflict_.push_back(other);
-            continue;
           }
-          touched_.push_back(other);
+          const bool in = inConflict(cells_[other].v, p);
+          mark(other, in ? IN_CONFLICT : OUTSIDE);
+          prefetchNeighbors(other);
+          conflict_[found] = other;
+          found += in;
+          touched_[outside] = other;
+          outside += !in;
+          border = !in;
         }
-        boundary_.push_back({cells_[c].v, i, across});
-        boundary_.back().v[i] = q;
+        BoundaryFacet& facet = boundary_[facets];
+        facet.v = cell.v;
+        facet.v[i] = q;
+        facet.i = i;
+        facet.across = across;
+        facets += border;
       }
     }
+    conflict_.resize(found);
+    touched_.resize(outside);
+    boundary_.resize(facets);
     // The conflict cells are reused first: the rest must be at hand before any
     // cell changes.
     if (boundary_.size() > conflict_.size() &&
@@ -374,7 +395,7 @@ private:
     const double m023 = m23 * ptz - m03 * qtz + m02 * stz;
     const double m123 = m23 * rtz - m13 * qtz + m12 * stz;
     const double det = m123 * pt2 - m023 * rt2 + m013 * qt2 - m012 * st2;
-    return det > eps ? 1 : det < -eps ? -1 : 0;
+    return (det > eps) - (det < -eps); // no branch on the sign
   }
 
   /** CGAL's semi-static filter of Orientation_3 in the same way: +1 or -1 where its
@@ -402,7 +423,7 @@ private:
     const double m02 = pqx * psy - psx * pqy;
     const double m12 = prx * psy - psx * pry;
     const double det = m01 * psz - m02 * prz + m12 * pqz;
-    return det > eps ? 1 : det < -eps ? -1 : 0;
+    return (det > eps) - (det < -eps); // no branch on the sign
   }
 
   /** Orientation_3 with the filter above inlined: > 0 positive. */
@@ -832,10 +853,11 @@ private:
   /** This builder's tag in the cells' states. */
   const std::uint8_t tag_;
   bool concurrent_;
-  std::vector<int> conflict_, touched_;
+  /** Sized ahead of use by the conflict search: default-initialized. */
+  std::vector<int, DefaultInitAllocator<int>> conflict_, touched_;
   /** The cells made by the latest insertion. */
   std::vector<int> star_;
-  std::vector<BoundaryFacet> boundary_;
+  std::vector<BoundaryFacet, DefaultInitAllocator<BoundaryFacet>> boundary_;
   std::vector<Edge> edges_;
   std::uint32_t stamp_ = 0;
   /** Vertices a hole's boundary may have for linkStarByNumbers(), the infinite one
