@@ -130,10 +130,11 @@ public:
     mark(first, IN_CONFLICT);
     // Breadth first, the conflict cells in the order found: a cell's neighbours
     // are fetched when it is found and read only after the cells found before it.
-    // Without a branch on a test's outcome, which is a coin flip to the branch
-    // predictor (a surface sample's conflict regions are large, some 30 cells with
-    // as many tested around them): a tested cell is written to both lists, and the
-    // one it belongs to grows; so is each facet to the boundary.
+    // Branches on what a neighbour is are coin flips to the branch predictor (a
+    // surface sample's conflict regions are large, some 30 cells with as many
+    // tested around them), so there are few: the neighbours to test are sorted out
+    // first, and a tested cell is written to both the conflict and the touched
+    // list, the one it belongs to growing; so is each facet to the boundary.
     std::size_t found = 0, outside = 0, facets = 0;
     const auto room = [](auto& list, std::size_t used) {
       if (list.size() < used + 4)
@@ -147,32 +148,41 @@ public:
       room(boundary_, facets);
       const int c = conflict_[next];
       const BuildCell& cell = cells_[c];
-      for (int i = 0; i < 4; ++i) {
-        const std::uint32_t across = cell.n[i];
-        const int other = static_cast<int>(across >> 2);
-        const std::uint8_t seen = stateOf(other);
-        bool border = seen == (tag_ | OUTSIDE);
-        if (!border && seen != (tag_ | IN_CONFLICT)) {
-          if (!take(other, OUTSIDE)) {
-            conflict_.resize(found);
-            touched_.resize(outside);
-            return abandon();
-          }
-          const bool in = inConflict(cells_[other].v, p);
-          mark(other, in ? IN_CONFLICT : OUTSIDE);
-          prefetchNeighbors(other);
-          conflict_[found] = other;
-          found += in;
-          touched_[outside] = other;
-          outside += !in;
-          border = !in;
-        }
+      const auto add_facet = [&](int i, bool border) {
         BoundaryFacet& facet = boundary_[facets];
         facet.v = cell.v;
         facet.v[i] = q;
         facet.i = i;
-        facet.across = across;
+        facet.across = cell.n[i];
         facets += border;
+      };
+      // The neighbours to test, sorted out first: one loop of as many tests
+      // instead of a branch per facet on what its neighbour was.
+      std::array<int, 4> untested;
+      int count = 0;
+      for (int i = 0; i < 4; ++i) {
+        const std::uint8_t seen = stateOf(static_cast<int>(cell.n[i] >> 2));
+        const bool border = seen == (tag_ | OUTSIDE);
+        untested[count] = i;
+        count += !border && seen != (tag_ | IN_CONFLICT);
+        add_facet(i, border);
+      }
+      for (int k = 0; k < count; ++k) {
+        const int i = untested[k];
+        const int other = static_cast<int>(cell.n[i] >> 2);
+        if (!take(other, OUTSIDE)) {
+          conflict_.resize(found);
+          touched_.resize(outside);
+          return abandon();
+        }
+        const bool in = inConflict(cells_[other].v, p);
+        mark(other, in ? IN_CONFLICT : OUTSIDE);
+        prefetchNeighbors(other);
+        conflict_[found] = other;
+        found += in;
+        touched_[outside] = other;
+        outside += !in;
+        add_facet(i, !in);
       }
     }
     conflict_.resize(found);
