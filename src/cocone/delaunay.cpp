@@ -774,15 +774,18 @@ private:
           numbers_[f][m] = 0;
           continue;
         }
+        // A vertex met for the first time takes the next number, without a branch
+        // (which vertex is new is a coin flip to the branch predictor).
         std::uint8_t& number = hole_vertex_[w];
-        if (number == UNNUMBERED) {
-          if (count == HOLE_VERTICES)
-            return false;
-          number = static_cast<std::uint8_t>(count++);
-        }
+        const bool fresh = number == UNNUMBERED;
+        number = fresh ? static_cast<std::uint8_t>(count) : number;
+        count += fresh;
         numbers_[f][m] = number;
       }
     }
+    // Numbers up to 63 (beyond, they were not used).
+    if (count > HOLE_VERTICES)
+      return false;
     const auto edge = [](std::uint8_t from, std::uint8_t to) {
       return std::size_t(from) * HOLE_VERTICES + to;
     };
