@@ -133,6 +133,45 @@ TEST(Triangulate, CellsNeighboursAndCircumcenters)
   }
 }
 
+TEST(Triangulate, CircumcentersTheSameWhicheverPassComputesThem)
+{
+  // The first pass that reads the circumcenters computes them as it goes, unless
+  // it reads its neighbours' too (then all are computed before it): both ways, and
+  // in later passes, the same bits per cell.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> P;
+  for (int i = 0; i < 3000; ++i)
+    P.emplace_back(u(random), u(random), 0.1 * u(random));
+  const std::vector<Eigen::Vector3d> points = makeUniquePoints(P).points;
+  using Centers = std::vector<std::pair<std::array<int, 4>, Eigen::Vector3d>>;
+  const auto centers = [](const Triangulation& dt, unsigned data, int threads) {
+    Centers out;
+    std::vector<Centers> part(threads);
+    forEachCell(dt, data, threads, [&](const CellView& c, int thread) {
+      auto v = c.v;
+      std::sort(v.begin(), v.end());
+      part[thread].emplace_back(v, c.circumcenter);
+    });
+    for (const auto& p : part)
+      out.insert(out.end(), p.begin(), p.end());
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+      return a.first < b.first;
+    });
+    return out;
+  };
+  const Triangulation first_alone = triangulate(points);
+  const Triangulation first_with_neighbours = triangulate(points);
+  const Centers alone = centers(first_alone, CellView::CIRCUMCENTER, 2);
+  const Centers with_neighbours =
+      centers(first_with_neighbours, CellView::CIRCUMCENTER | CellView::NEIGHBORS, 2);
+  ASSERT_EQ(alone.size(), first_alone.number_of_cells);
+  EXPECT_TRUE(alone == with_neighbours);
+  EXPECT_TRUE(alone == centers(first_alone, CellView::CIRCUMCENTER, 1));
+  EXPECT_TRUE(alone ==
+              centers(first_alone, CellView::NEIGHBORS | CellView::CIRCUMCENTER, 1));
+}
+
 TEST(Triangulate, EveryEdgeStoodForByACell)
 {
   std::vector<Eigen::Vector3d> P;

@@ -142,11 +142,11 @@ public:
     };
     room(conflict_, 0);
     conflict_[found++] = first;
-    for (std::size_t next = 0; next < found; ++next) {
+    for (std::size_t head = 0; head < found; ++head) {
       room(conflict_, found);
       room(touched_, outside);
       room(boundary_, facets);
-      const int c = conflict_[next];
+      const int c = conflict_[head];
       const BuildCell& cell = cells_[c];
       const auto add_facet = [&](int i, bool border) {
         BoundaryFacet& facet = boundary_[facets];
