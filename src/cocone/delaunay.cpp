@@ -140,6 +140,11 @@ public:
       if (list.size() < used + 4)
         list.resize(std::max(2 * list.size(), used + 4));
     };
+    const auto trim = [&]() {
+      conflict_.resize(found);
+      touched_.resize(outside);
+      boundary_.resize(facets);
+    };
     room(conflict_, 0);
     conflict_[found++] = first;
     for (std::size_t head = 0; head < found; ++head) {
@@ -171,8 +176,7 @@ public:
         const int i = untested[k];
         const int other = static_cast<int>(cell.n[i] >> 2);
         if (!take(other, OUTSIDE)) {
-          conflict_.resize(found);
-          touched_.resize(outside);
+          trim();
           return abandon();
         }
         const bool in = inConflict(cells_[other].v, p);
@@ -185,9 +189,7 @@ public:
         add_facet(i, !in);
       }
     }
-    conflict_.resize(found);
-    touched_.resize(outside);
-    boundary_.resize(facets);
+    trim();
     // The conflict cells are reused first: the rest must be at hand before any
     // cell changes.
     if (boundary_.size() > conflict_.size() &&
@@ -363,6 +365,24 @@ private:
     return Kernel::Compare_xyz_3()(*a, *b) == CGAL::SMALLER;
   }
 
+  /** The largest absolute value of \a first and \a rest, without a branch. */
+  template <typename... Rest>
+  static double
+  maxAbs(double first, Rest... rest)
+  {
+    double m = std::abs(first);
+    ((m = std::max(m, std::abs(rest))), ...);
+    return m;
+  }
+
+  /** A semi-static filter's answer: the sign of \a det where its error bound \a eps
+   * decides it, else 0; without a branch on the sign. */
+  static int
+  filteredSign(double det, double eps)
+  {
+    return (det > eps) - (det < -eps);
+  }
+
   /** CGAL's semi-static filter of Side_of_oriented_sphere_3 (the same determinant,
    * the same error bound) with its maxima taken without branches: +1 or -1 where the
    * bound decides the sign, 0 where only CGAL's predicate can. */
@@ -378,13 +398,9 @@ private:
     const double qt2 = qtx * qtx + qty * qty + qtz * qtz;
     const double rt2 = rtx * rtx + rty * rty + rtz * rtz;
     const double st2 = stx * stx + sty * sty + stz * stz;
-    const auto max4 = [](double a, double b, double c, double d) {
-      return std::max(std::max(std::abs(a), std::abs(b)),
-                      std::max(std::abs(c), std::abs(d)));
-    };
-    const double maxx = max4(ptx, qtx, rtx, stx);
-    const double maxy = max4(pty, qty, rty, sty);
-    const double maxz = max4(ptz, qtz, rtz, stz);
+    const double maxx = maxAbs(ptx, qtx, rtx, stx);
+    const double maxy = maxAbs(pty, qty, rty, sty);
+    const double maxz = maxAbs(ptz, qtz, rtz, stz);
     const double lo = std::min(std::min(maxx, maxy), maxz);
     const double hi = std::max(std::max(maxx, maxy), maxz);
     // Outside CGAL's range against underflow and overflow: its predicate decides.
@@ -404,8 +420,7 @@ private:
     const double m013 = m13 * ptz - m03 * rtz + m01 * stz;
     const double m023 = m23 * ptz - m03 * qtz + m02 * stz;
     const double m123 = m23 * rtz - m13 * qtz + m12 * stz;
-    const double det = m123 * pt2 - m023 * rt2 + m013 * qt2 - m012 * st2;
-    return (det > eps) - (det < -eps); // no branch on the sign
+    return filteredSign(m123 * pt2 - m023 * rt2 + m013 * qt2 - m012 * st2, eps);
   }
 
   /** CGAL's semi-static filter of Orientation_3 in the same way: +1 or -1 where its
@@ -417,12 +432,9 @@ private:
     const double pqx = q.x() - p.x(), pqy = q.y() - p.y(), pqz = q.z() - p.z();
     const double prx = r.x() - p.x(), pry = r.y() - p.y(), prz = r.z() - p.z();
     const double psx = s.x() - p.x(), psy = s.y() - p.y(), psz = s.z() - p.z();
-    const auto max3 = [](double a, double b, double c) {
-      return std::max(std::max(std::abs(a), std::abs(b)), std::abs(c));
-    };
-    const double maxx = max3(pqx, prx, psx);
-    const double maxy = max3(pqy, pry, psy);
-    const double maxz = max3(pqz, prz, psz);
+    const double maxx = maxAbs(pqx, prx, psx);
+    const double maxy = maxAbs(pqy, pry, psy);
+    const double maxz = maxAbs(pqz, prz, psz);
     const double lo = std::min(std::min(maxx, maxy), maxz);
     const double hi = std::max(std::max(maxx, maxy), maxz);
     if (!(lo >= 1e-97 && hi < 1e102))
@@ -432,8 +444,7 @@ private:
     const double m01 = pqx * pry - prx * pqy;
     const double m02 = pqx * psy - psx * pqy;
     const double m12 = prx * psy - psx * pry;
-    const double det = m01 * psz - m02 * prz + m12 * pqz;
-    return (det > eps) - (det < -eps); // no branch on the sign
+    return filteredSign(m01 * psz - m02 * prz + m12 * pqz, eps);
   }
 
   /** Orientation_3 with the filter above inlined: > 0 positive. */
@@ -462,6 +473,8 @@ private:
     // Co-spherical: perturb the points, the lexicographically largest most.
     std::array<const Point*, 5> sorted{&p0, &p1, &p2, &p3, &p};
     std::sort(sorted.begin(), sorted.end(), perturbationOrder);
+    // (CGAL's predicate itself: this rare path is kept small, out of the way of
+    // the inlined filters.)
     const Kernel::Orientation_3 orientation;
     for (int i = 4; i > 2; --i) {
       if (sorted[i] == &p)
@@ -1013,13 +1026,14 @@ buildDelaunay(const std::vector<Eigen::Vector3d>& input, BuildCells& cells, int 
         ++r;
       round[order[k]] = static_cast<std::uint8_t>(r);
     }
-    std::vector<int> place(round_end.size() + 1, 0);
-    for (int i = 0; i < n; ++i)
-      ++place[round[i] + 1];
-    for (std::size_t r = 1; r < place.size(); ++r)
-      place[r] += place[r - 1];
-    for (int i = 0; i < n; ++i)
-      order[place[round[i]]++] = i;
+    countingSort(
+        n,
+        round_end.size(),
+        threads,
+        [&](std::size_t i) { return round[i]; },
+        [&](std::size_t i, std::uint32_t place) {
+          order[place] = static_cast<int>(i);
+        });
   }
 
   // The affine dimension, and a first tetrahedron: the first two points, the first

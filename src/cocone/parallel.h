@@ -2,8 +2,8 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * Splitting a loop among threads, and sets that threads unite at once (not
- * installed).
+ * Splitting a loop among threads, a counting sort on them, and sets that threads
+ * unite at once (not installed).
  */
 
 #pragma once
@@ -59,6 +59,47 @@ forEachRange(std::size_t count, int parts, const Body& body)
   }
   if (failed)
     throw std::bad_alloc();
+}
+
+/** A stable counting sort of the items [0, count) by key(i), below \a buckets: calls
+ * put(i, place) for every item, where the places of one key are together and in
+ * ascending order of the items. With several threads, each counts and places a part
+ * of the items: the same places.
+ * \return per key b, where its items begin; then the end (count) */
+template <typename Key, typename Put>
+std::vector<std::uint32_t>
+countingSort(
+    std::size_t count, std::size_t buckets, int threads, const Key& key, const Put& put)
+{
+  const int parts = partsFor(count, threads);
+  // Per part and key: its count of items, then where the first of them goes (the
+  // parts in order within a key).
+  std::vector<std::vector<std::uint32_t>> place(parts);
+  for (auto& p : place)
+    p.resize(buckets);
+  forEachRange(count, parts, [&](std::size_t begin, std::size_t end, int part) {
+    auto& counted = place[part];
+    std::fill(counted.begin(), counted.end(), 0);
+    for (std::size_t i = begin; i < end; ++i)
+      ++counted[key(i)];
+  });
+  std::vector<std::uint32_t> start(buckets + 1);
+  std::uint32_t total = 0;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    start[b] = total;
+    for (auto& p : place) {
+      const std::uint32_t here = p[b];
+      p[b] = total;
+      total += here;
+    }
+  }
+  start[buckets] = total;
+  forEachRange(count, parts, [&](std::size_t begin, std::size_t end, int part) {
+    auto& next = place[part];
+    for (std::size_t i = begin; i < end; ++i)
+      put(i, next[key(i)]++);
+  });
+  return start;
 }
 
 /** Disjoint sets of 0 .. n - 1 that several threads unite at once without locks,
