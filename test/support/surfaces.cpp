@@ -540,6 +540,9 @@ randomSites(const std::vector<Part>& parts, const SampleOptions& o, Rng& rng)
   return sites;
 }
 
+/** Whether two candidates (by index) may exclude each other; empty: any two may. */
+using Together = std::function<bool(std::uint32_t, std::uint32_t)>;
+
 /** For each candidate, the earlier candidates closer than the cut-off. */
 struct CloseEarlier {
   std::vector<std::uint32_t> first; // per candidate + 1: its entries in other / t
@@ -550,7 +553,8 @@ struct CloseEarlier {
 CloseEarlier
 closeEarlier(const std::vector<Eigen::Vector3d>& pos,
              const std::vector<double>& scale,
-             double cutoff)
+             double cutoff,
+             const Together& together)
 {
   // scale <= 1, so every pair that matters lies in neighbouring cells of size cutoff.
   const PointGrid grid(pos, cutoff);
@@ -575,6 +579,8 @@ closeEarlier(const std::vector<Eigen::Vector3d>& pos,
     if (d2 < cutoff2 * h * h) {
       const auto i = static_cast<std::uint32_t>(index[a]);
       const auto j = static_cast<std::uint32_t>(index[b]);
+      if (together && !together(i, j))
+        return;
       pairs.push_back(
           {std::max(i, j), std::min(i, j), static_cast<float>(std::sqrt(d2) / h)});
     }
@@ -635,7 +641,10 @@ acceptAt(const CloseEarlier& close, double r, std::vector<char>& accepted)
 /** Poisson-disk sites: 8x area-uniform candidates (already thinned to the density),
  *  greedy elimination at a radius r / sqrt (density), r tuned to hit o.n. */
 std::vector<Site>
-poissonSites(const std::vector<Part>& parts, const SampleOptions& o, Rng& rng)
+poissonSites(const std::vector<Part>& parts,
+             const SampleOptions& o,
+             Rng& rng,
+             const std::function<bool(const Site&, const Site&)>& together = {})
 {
   const std::size_t n = o.n;
   const std::size_t m = 8 * n;
@@ -655,12 +664,17 @@ poissonSites(const std::vector<Part>& parts, const SampleOptions& o, Rng& rng)
       std::sqrt(0.55 * source.area() * source.meanDensity() / double(n));
   const long tolerance = std::max(1L, std::lround(0.005 * double(n)));
   const long target = static_cast<long>(n);
+  Together pair_ok;
+  if (together)
+    pair_ok = [&](std::uint32_t i, std::uint32_t j) {
+      return together(candidates[i], candidates[j]);
+    };
 
   std::vector<char> accepted(m), best_accepted;
   long best_miss = std::numeric_limits<long>::max();
   double cutoff = 1.15 * r_est;
   for (int attempt = 0; attempt < 6 && best_miss > tolerance; ++attempt) {
-    const CloseEarlier close = closeEarlier(pos, scale, cutoff);
+    const CloseEarlier close = closeEarlier(pos, scale, cutoff, pair_ok);
     // Count(r) falls roughly like r^-2: secant steps in that model, kept inside the
     // bracket [lo, hi] (count(lo) > n > count(hi)), else bisection.
     double lo = 0.0, hi = cutoff;
@@ -766,6 +780,7 @@ assemble(const std::string& name,
 {
   Sample s;
   s.name = name;
+  s.outlier.assign(sites.size(), false);
   for (const Site& site : sites) {
     s.points.push_back(site.p);
     s.normals.push_back(site.n);
@@ -1204,6 +1219,230 @@ struct CumulativeTable {
   }
 };
 
+/** Mean nearest-neighbour distance within groups of sites (key (site) >= 0: its
+ *  group; < 0: left out), over all sites in a group. */
+template <typename Key>
+double
+meanNearestDistanceWithin(const std::vector<Site>& sites, Key&& key, double cell)
+{
+  std::vector<std::vector<Eigen::Vector3d>> groups;
+  for (const Site& site : sites) {
+    const int k = key(site);
+    if (k < 0)
+      continue;
+    if (static_cast<std::size_t>(k) >= groups.size())
+      groups.resize(k + 1);
+    groups[k].push_back(site.p);
+  }
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const auto& group : groups) {
+    sum += meanNearestDistance(group, cell) * double(group.size());
+    count += group.size();
+  }
+  return count ? sum / double(count) : 0.0;
+}
+
+/** One counter-clockwise piece of a planar domain's boundary: the segment from a to
+ *  b, or (radius > 0) the arc about a from angle phi0 over sweep, convex (sign +1:
+ *  the domain inside the circle) or concave (-1: a hole's rim). */
+struct Rim {
+  Eigen::Vector2d a, b;
+  double radius = 0.0, phi0 = 0.0, sweep = 0.0, sign = 1.0;
+};
+
+Rim
+segmentRim(double ax, double ay, double bx, double by)
+{
+  Rim rim;
+  rim.a = Eigen::Vector2d(ax, ay);
+  rim.b = Eigen::Vector2d(bx, by);
+  return rim;
+}
+
+Rim
+arcRim(double cx, double cy, double radius, double phi0, double sweep, double sign)
+{
+  Rim rim;
+  rim.a = Eigen::Vector2d(cx, cy);
+  rim.radius = radius;
+  rim.phi0 = phi0;
+  rim.sweep = sweep;
+  rim.sign = sign;
+  return rim;
+}
+
+/** The points at distance r from a planar domain D in z = 0 (r below the radius of
+ *  every concave rim): D's copies at z = +-r (normals +-z) joined by half tubes
+ *  around D's boundary. outside (p): the distance from p to D, exactly 0 in D. On
+ *  a rim piece of length L and curvature k the half tube's area element is
+ *  r (1 + k r cos theta) dtheta ds, theta in [-pi/2, pi/2]. */
+Part
+slabPart(const std::function<double(const Eigen::Vector2d&)>& outside,
+         double domain_area,
+         const Eigen::Vector2d& lo,
+         const Eigen::Vector2d& hi,
+         const std::vector<Rim>& rims,
+         double r,
+         int euler)
+{
+  std::vector<double> cumulative{domain_area, 2.0 * domain_area};
+  for (const Rim& rim : rims) {
+    const double area = rim.radius > 0.0
+                            ? r * (kPi * rim.radius * std::abs(rim.sweep) +
+                                   2.0 * rim.sign * r * std::abs(rim.sweep))
+                            : kPi * r * std::sqrt(sq2(rim.b - rim.a));
+    cumulative.push_back(cumulative.back() + area);
+  }
+  Part part;
+  part.area = cumulative.back();
+  part.x_lo = lo.x() - r;
+  part.x_hi = hi.x() + r;
+  part.draw = [=](Rng& rng) {
+    const double u = rng.uniform01() * cumulative.back();
+    const std::size_t k = std::min<std::size_t>(
+        std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin(),
+        cumulative.size() - 1);
+    Site s;
+    if (k < 2) {
+      const double side = k == 0 ? 1.0 : -1.0;
+      for (;;) {
+        const double x = rng.uniform(lo.x(), hi.x());
+        const Eigen::Vector2d q(x, rng.uniform(lo.y(), hi.y()));
+        if (outside(q) == 0.0) {
+          s.p = Eigen::Vector3d(q.x(), q.y(), side * r);
+          s.n = Eigen::Vector3d(0.0, 0.0, side);
+          return s;
+        }
+      }
+    }
+    const Rim& rim = rims[k - 2];
+    // Accepted with probability (1 + k r cos theta) / (1 + max (k, 0) r).
+    const double bound =
+        1.0 + (rim.radius > 0.0 ? std::max(0.0, rim.sign) * r / rim.radius : 0.0);
+    for (;;) {
+      const double t = rng.uniform01();
+      const Eigen::Vector2d c = rng.unitCircle(); // theta uniform in [-pi/2, pi/2]
+      const double cos_t = std::abs(c.x()), sin_t = c.y();
+      const double weight =
+          rim.radius > 0.0 ? 1.0 + rim.sign * r * cos_t / rim.radius : 1.0;
+      if (!(rng.uniform01() * bound < weight))
+        continue;
+      // The boundary point b and D's outward normal m there.
+      Eigen::Vector2d b, m;
+      if (rim.radius > 0.0) {
+        const Eigen::Vector2d cs = portableCosSin(rim.phi0 + rim.sweep * t);
+        b = rim.a + rim.radius * cs;
+        m = rim.sign * cs;
+      }
+      else {
+        const Eigen::Vector2d d = rim.b - rim.a;
+        b = rim.a + t * d;
+        m = Eigen::Vector2d(d.y(), -d.x()) / std::sqrt(sq2(d));
+      }
+      s.n = Eigen::Vector3d(cos_t * m.x(), cos_t * m.y(), sin_t);
+      s.p = Eigen::Vector3d(b.x(), b.y(), 0.0) + r * s.n;
+      return s;
+    }
+  };
+  part.distance = [outside, r](const Eigen::Vector3d& q) {
+    return std::abs(std::hypot(outside(q.head<2>()), q.z()) - r);
+  };
+  part.euler = euler;
+  return part;
+}
+
+/** The trefoil (sin t + 2 sin 2t, cos t - 2 cos 2t, -sin 3t) and its first two
+ *  derivatives at (cos t, sin t) = cs, with the multiple angles by polynomials. */
+struct CurvePoint {
+  Eigen::Vector3d p, d1, d2;
+};
+
+CurvePoint
+trefoil(const Eigen::Vector2d& cs)
+{
+  const double c = cs.x(), s = cs.y();
+  const double c2 = c * c - s * s, s2 = 2.0 * s * c;
+  const double c3 = c * c2 - s * s2, s3 = s * c2 + c * s2;
+  return {Eigen::Vector3d(s + 2.0 * s2, c - 2.0 * c2, -s3),
+          Eigen::Vector3d(c + 4.0 * c2, -s + 4.0 * s2, -3.0 * c3),
+          Eigen::Vector3d(-s - 8.0 * s2, -c + 8.0 * c2, 9.0 * s3)};
+}
+
+/** Distance to the trefoil: the nearest of a table of curve points, refined by
+ *  Newton steps on (gamma (t) - q) . gamma' (t) = 0 within a table step. */
+class TrefoilDistance {
+public:
+  TrefoilDistance()
+  {
+    for (int k = 0; k < kTable; ++k)
+      table_.push_back(trefoil(portableCosSin(2.0 * kPi * k / kTable)).p);
+  }
+
+  double
+  operator()(const Eigen::Vector3d& q) const
+  {
+    int best = 0;
+    double best2 = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < kTable; ++k) {
+      const double d2 = sq3(table_[k] - q);
+      if (d2 < best2) {
+        best2 = d2;
+        best = k;
+      }
+    }
+    const double h = 2.0 * kPi / kTable, t0 = best * h;
+    double t = t0;
+    for (int it = 0; it < 30; ++it) {
+      const CurvePoint c = trefoil(portableCosSin(t));
+      const Eigen::Vector3d r = c.p - q;
+      const double g = dot3(r, c.d1), dg = sq3(c.d1) + dot3(r, c.d2);
+      if (!(dg > 0.0))
+        break;
+      const double next = std::max(t0 - h, std::min(t0 + h, t - g / dg));
+      if (next == t)
+        break;
+      t = next;
+    }
+    return std::sqrt(std::min(best2, sq3(trefoil(portableCosSin(t)).p - q)));
+  }
+
+private:
+  static constexpr int kTable = 2048;
+  std::vector<Eigen::Vector3d> table_;
+};
+
+/** Indices 0 .. n - 1 in a random order's first `count` places (partial
+ *  Fisher-Yates). */
+std::vector<std::size_t>
+randomSubset(std::size_t n, std::size_t count, Rng& rng)
+{
+  std::vector<std::size_t> index(n);
+  for (std::size_t i = 0; i < n; ++i)
+    index[i] = i;
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto j =
+        std::min(n - 1, i + static_cast<std::size_t>(rng.uniform01() * double(n - i)));
+    std::swap(index[i], index[j]);
+  }
+  index.resize(count);
+  return index;
+}
+
+/** Bounding box corner by corner, in a fixed order. */
+void
+boundingBox(const std::vector<Eigen::Vector3d>& points,
+            Eigen::Vector3d& lo,
+            Eigen::Vector3d& hi)
+{
+  lo = hi = points.front();
+  for (const Eigen::Vector3d& p : points)
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], p[i]);
+      hi[i] = std::max(hi[i], p[i]);
+    }
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------------
@@ -1523,6 +1762,448 @@ sphereWithHoles(const SampleOptions& o, int holes, double hole_angle)
   }
   part.euler = 2 - holes;
   return generate("sphere_with_holes", {part}, o);
+}
+
+Sample
+genus2(const SampleOptions& o)
+{
+  // The stadium: the segment [-a, a] x {0} widened by ro; holes of radius rh about
+  // (+-a, 0); r < rh keeps the holes open.
+  const double a = 1.0, ro = 1.0, rh = 0.5, r = 0.3;
+  const auto outside = [a, ro, rh](const Eigen::Vector2d& p) {
+    for (const double cx : {-a, a}) {
+      const double d = std::sqrt(sq2(p - Eigen::Vector2d(cx, 0.0)));
+      if (d < rh)
+        return rh - d;
+    }
+    const double x = std::max(0.0, std::abs(p.x()) - a);
+    return std::max(0.0, std::sqrt(x * x + p.y() * p.y()) - ro);
+  };
+  const std::vector<Rim> rims{segmentRim(-a, -ro, a, -ro),
+                              arcRim(a, 0.0, ro, -0.5 * kPi, kPi, 1.0),
+                              segmentRim(a, ro, -a, ro),
+                              arcRim(-a, 0.0, ro, 0.5 * kPi, kPi, 1.0),
+                              arcRim(-a, 0.0, rh, 0.0, 2.0 * kPi, -1.0),
+                              arcRim(a, 0.0, rh, 0.0, 2.0 * kPi, -1.0)};
+  const double domain_area = kPi * ro * ro + 4.0 * a * ro - 2.0 * kPi * rh * rh;
+  return generate("genus2",
+                  {slabPart(outside,
+                            domain_area,
+                            Eigen::Vector2d(-a - ro, -ro),
+                            Eigen::Vector2d(a + ro, ro),
+                            rims,
+                            r,
+                            -2)},
+                  o);
+}
+
+Sample
+thinPlate(const SampleOptions& o, double thickness)
+{
+  checkOptions(o);
+  requirePositive(thickness, "thickness");
+  // The rectangle [-wx, wx] x [-wy, wy] with corners rounded by rc: the rectangle
+  // [-ix, ix] x [-iy, iy] widened by rc.
+  const double wx = 1.0, wy = 0.7, rc = 0.2, ix = wx - rc, iy = wy - rc;
+  const auto outside = [ix, iy, rc](const Eigen::Vector2d& p) {
+    const double x = std::max(0.0, std::abs(p.x()) - ix);
+    const double y = std::max(0.0, std::abs(p.y()) - iy);
+    return std::max(0.0, std::sqrt(x * x + y * y) - rc);
+  };
+  const std::vector<Rim> rims{segmentRim(-ix, -wy, ix, -wy),
+                              arcRim(ix, -iy, rc, -0.5 * kPi, 0.5 * kPi, 1.0),
+                              segmentRim(wx, -iy, wx, iy),
+                              arcRim(ix, iy, rc, 0.0, 0.5 * kPi, 1.0),
+                              segmentRim(ix, wy, -ix, wy),
+                              arcRim(-ix, iy, rc, 0.5 * kPi, 0.5 * kPi, 1.0),
+                              segmentRim(-wx, iy, -wx, -iy),
+                              arcRim(-ix, -iy, rc, kPi, 0.5 * kPi, 1.0)};
+  const std::vector<Part> parts{slabPart(outside,
+                                         4.0 * wx * wy - (4.0 - kPi) * rc * rc,
+                                         Eigen::Vector2d(-wx, -wy),
+                                         Eigen::Vector2d(wx, wy),
+                                         rims,
+                                         0.5 * thickness,
+                                         2)};
+  Rng rng(o.seed);
+  std::vector<Site> sites;
+  if (o.even) {
+    // Candidates on opposite sheets (normals more than 90 degrees apart) do not
+    // exclude each other.
+    sites = poissonSites(parts, o, rng, [](const Site& s, const Site& t) {
+      return dot3(s.n, t.n) > 0.0;
+    });
+  }
+  else
+    sites = randomSites(parts, o, rng);
+  const double spacing = meanNearestDistanceWithin(
+      sites,
+      [](const Site& site) { return site.n.z() > 0.0 ? 0 : 1; },
+      std::sqrt(parts[0].area / double(sites.size())));
+  return assemble("thin_plate", parts, sites, spacing, o, rng);
+}
+
+Sample
+cube(const SampleOptions& o, double side)
+{
+  requirePositive(side, "side");
+  const double h = 0.5 * side;
+  Part part;
+  part.area = 6.0 * side * side;
+  part.x_lo = -h;
+  part.x_hi = h;
+  part.draw = [h](Rng& rng) {
+    const int face = std::min(5, static_cast<int>(6.0 * rng.uniform01()));
+    const int axis = face % 3;
+    const double sign = face < 3 ? 1.0 : -1.0;
+    Site s;
+    s.p[axis] = sign * h;
+    s.p[(axis + 1) % 3] = rng.uniform(-h, h);
+    s.p[(axis + 2) % 3] = rng.uniform(-h, h);
+    s.n = Eigen::Vector3d::Zero();
+    s.n[axis] = sign;
+    return s;
+  };
+  part.distance = [h](const Eigen::Vector3d& q) {
+    const Eigen::Vector3d d = q.cwiseAbs() - Eigen::Vector3d::Constant(h);
+    if (d.maxCoeff() > 0.0)
+      return d.cwiseMax(0.0).norm();
+    return -d.maxCoeff();
+  };
+  part.euler = 2;
+  return generate("cube", {part}, o);
+}
+
+Sample
+tube(const SampleOptions& o, double radius)
+{
+  requirePositive(radius, "radius");
+  // The trefoil's curvature is at most 0.78 and distant strands are more than 1.2
+  // apart: below 0.5 the tube does not touch itself.
+  if (radius >= 0.5)
+    throw std::invalid_argument("cocone_test: tube needs radius < 0.5");
+  // |gamma'|^2 = 17 + 8 cos 3t + 9 cos^2 3t in [15.2, 34], |gamma''|^2 <= 162: the
+  // area element |gamma'| (1 - radius kappa . u) is below the bound.
+  const double bound = std::sqrt(34.0) * (1.0 + radius * std::sqrt(162.0) / 15.2);
+  double length = 0.0; // midpoint rule: spectrally accurate for a periodic integrand
+  const int steps = 4096;
+  double x_lo = 0.0, x_hi = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    const CurvePoint c = trefoil(portableCosSin(2.0 * kPi * (k + 0.5) / steps));
+    length += std::sqrt(sq3(c.d1));
+    x_lo = std::min(x_lo, c.p.x());
+    x_hi = std::max(x_hi, c.p.x());
+  }
+  length *= 2.0 * kPi / steps;
+  Part part;
+  part.area = 2.0 * kPi * radius * length;
+  part.x_lo = x_lo - radius;
+  part.x_hi = x_hi + radius;
+  part.draw = [radius, bound](Rng& rng) {
+    for (;;) {
+      const CurvePoint c = trefoil(rng.unitCircle());
+      const double speed2 = sq3(c.d1);
+      Eigen::Vector3d e1, e2;
+      frame(c.d1 / std::sqrt(speed2), e1, e2);
+      const Eigen::Vector2d v = rng.unitCircle();
+      const Eigen::Vector3d u = v.x() * e1 + v.y() * e2;
+      // kappa . u = gamma'' . u / |gamma'|^2 for u normal to gamma'.
+      const double weight = std::sqrt(speed2) * (1.0 - radius * dot3(c.d2, u) / speed2);
+      if (rng.uniform01() * bound < weight) {
+        Site s;
+        s.n = u;
+        s.p = c.p + radius * u;
+        return s;
+      }
+    }
+  };
+  const auto curve = std::make_shared<TrefoilDistance>();
+  part.distance = [curve, radius](const Eigen::Vector3d& q) {
+    return std::abs((*curve)(q)-radius);
+  };
+  part.euler = 0;
+  return generate("tube", {part}, o);
+}
+
+Sample
+twoTouchingSpheres(const SampleOptions& o, double radius, double gap)
+{
+  checkOptions(o);
+  if (!(gap >= 0.0) || !std::isfinite(gap))
+    throw std::invalid_argument("cocone_test: gap must be >= 0");
+  // Both spheres are sampled about the origin, each on its own, and moved apart once
+  // the spacing is known.
+  std::vector<Part> parts{spherePart(radius), spherePart(radius)};
+  Rng rng(o.seed);
+  std::vector<Site> sites = o.even ? poissonSites(parts,
+                                                  o,
+                                                  rng,
+                                                  [](const Site& s, const Site& t) {
+                                                    return s.component == t.component;
+                                                  })
+                                   : randomSites(parts, o, rng);
+  const double spacing = meanNearestDistanceWithin(
+      sites,
+      [](const Site& site) { return site.component; },
+      std::sqrt(2.0 * parts[0].area / double(sites.size())));
+  const double shift = radius + 0.5 * gap * spacing;
+  const Eigen::Vector3d offset[2] = {Eigen::Vector3d(-shift, 0.0, 0.0),
+                                     Eigen::Vector3d(shift, 0.0, 0.0)};
+  for (int k = 0; k < 2; ++k)
+    parts[k] = translated(parts[k], offset[k]);
+  for (Site& site : sites)
+    site.p += offset[site.component];
+  return assemble("two_touching_spheres", parts, sites, spacing, o, rng);
+}
+
+Sample
+rangeViews(const Sample& surface,
+           int views,
+           double registration_error,
+           std::uint64_t seed,
+           double noise,
+           double keep)
+{
+  if (views < 1)
+    throw std::invalid_argument("cocone_test: rangeViews needs views >= 1");
+  if (!(registration_error >= 0.0) || !std::isfinite(registration_error))
+    throw std::invalid_argument("cocone_test: registration_error must be >= 0");
+  if (!(noise >= 0.0) || !std::isfinite(noise))
+    throw std::invalid_argument("cocone_test: noise must be >= 0");
+  if (!(keep > 0.0 && keep <= 1.0))
+    throw std::invalid_argument("cocone_test: keep must be in (0, 1]");
+  if (surface.points.empty() || surface.normals.size() != surface.points.size())
+    throw std::invalid_argument("cocone_test: rangeViews needs a sampled surface");
+  const std::vector<Eigen::Vector3d>& sites = surface.points;
+  const std::size_t n = sites.size();
+  const auto usable = [&](std::size_t i) {
+    return surface.outlier.empty() || !surface.outlier[i];
+  };
+  Eigen::Vector3d lo, hi;
+  boundingBox(sites, lo, hi);
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double extent = 0.5 * std::sqrt(sq3(hi - lo));
+  const double s = surface.spacing;
+  Rng rng(seed);
+
+  // Views one after the other: a z-buffer of the splatted points, then each visible
+  // point not yet kept is kept with probability keep.
+  std::vector<int> owner(n, -1);
+  std::vector<char> seen(n, false);
+  std::vector<std::size_t> kept;
+  for (int v = 0; v < views; ++v) {
+    const double z = 1.0 - (2.0 * v + 1.0) / views;
+    const Eigen::Vector2d cs = portableCosSin(v * kPi * (3.0 - std::sqrt(5.0)));
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Eigen::Vector3d d(rho * cs.x(), rho * cs.y(), z);
+    const Eigen::Vector3d camera = centre + 4.0 * extent * d;
+    Eigen::Vector3d e1, e2;
+    frame(d, e1, e2);
+    // Image coordinates: tangents of the view angles, cells of 0.7 spacings at the
+    // centre's distance. Each point is a disc of radius 2 spacings in its tangent
+    // plane, drawn into the cells within 3 of its own (which covers the gaps
+    // between the samples at every angle); a point is seen where it is at most 1.5
+    // spacings behind the nearest disc in its cell.
+    const double cell = 0.7 * s / (4.0 * extent);
+    const long reach = 3;
+    std::vector<long> ci(n), cj(n);
+    long i0 = std::numeric_limits<long>::max(), j0 = i0, i1 = -i0, j1 = -i0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d w = sites[i] - camera;
+      const double depth = -dot3(w, d);
+      ci[i] = static_cast<long>(std::floor(dot3(w, e1) / depth / cell));
+      cj[i] = static_cast<long>(std::floor(dot3(w, e2) / depth / cell));
+      i0 = std::min(i0, ci[i]);
+      i1 = std::max(i1, ci[i]);
+      j0 = std::min(j0, cj[i]);
+      j1 = std::max(j1, cj[i]);
+    }
+    i0 -= reach;
+    j0 -= reach;
+    const long wj = j1 - j0 + reach + 1;
+    std::vector<double> zbuffer((i1 - i0 + reach + 1) * wj,
+                                std::numeric_limits<double>::infinity());
+    const double disc2 = 4.0 * s * s;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!usable(i))
+        continue;
+      const Eigen::Vector3d& nrm = surface.normals[i];
+      const double height = dot3(nrm, sites[i] - camera);
+      for (long a = ci[i] - reach; a <= ci[i] + reach; ++a)
+        for (long b = cj[i] - reach; b <= cj[i] + reach; ++b) {
+          // The ray through the cell's centre, at depth t: camera + t ray.
+          const Eigen::Vector3d ray =
+              ((a + 0.5) * cell) * e1 + ((b + 0.5) * cell) * e2 - d;
+          const double slope = dot3(nrm, ray);
+          if (slope == 0.0)
+            continue;
+          const double t = height / slope;
+          if (t > 0.0 && sq3(camera + t * ray - sites[i]) <= disc2) {
+            double& z = zbuffer[(a - i0) * wj + (b - j0)];
+            z = std::min(z, t);
+          }
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!usable(i))
+        continue;
+      double facing = dot3(surface.normals[i], camera - sites[i]);
+      if (!surface.closed)
+        facing = std::abs(facing);
+      if (!(facing > 0.0) || -dot3(sites[i] - camera, d) >
+                                 zbuffer[(ci[i] - i0) * wj + (cj[i] - j0)] + 1.5 * s)
+        continue;
+      seen[i] = true;
+      if (owner[i] < 0 && rng.uniform01() < keep) {
+        owner[i] = v;
+        kept.push_back(i);
+      }
+    }
+  }
+  if (kept.empty())
+    throw std::invalid_argument("cocone_test: rangeViews: no view sees the surface");
+  // Views in order, each in the order of the sites.
+  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
+    return owner[a] < owner[b];
+  });
+
+  Sample out;
+  out.name = surface.name + "_range_views";
+  out.area = surface.area;
+  out.distance = surface.distance;
+  for (const std::size_t i : kept) {
+    out.points.push_back(sites[i]);
+    out.normals.push_back(surface.normals[i]);
+    out.view.push_back(owner[i]);
+    out.component.push_back(surface.component.empty() ? 0 : surface.component[i]);
+    out.near_boundary.push_back(!surface.near_boundary.empty() &&
+                                surface.near_boundary[i]);
+  }
+  out.outlier.assign(kept.size(), false);
+  out.spacing = meanNearestDistance(out.points, s);
+
+  // Coverage: every site within 2 (dense) spacings of one that a view saw.
+  std::vector<Eigen::Vector3d> visible, unseen;
+  for (std::size_t i = 0; i < n; ++i)
+    if (seen[i])
+      visible.push_back(sites[i]);
+  const PointGrid grid(visible, s);
+  for (std::size_t i = 0; i < n; ++i) {
+    double dist = 0.0;
+    if (usable(i) && !seen[i] && grid.nearest(sites[i], 2.0 * s, -1, dist) < 0)
+      unseen.push_back(sites[i]);
+  }
+  if (unseen.empty()) {
+    out.boundary_curve = surface.boundary_curve;
+    out.boundary_curve_loop = surface.boundary_curve_loop;
+    out.boundary_loops = surface.boundary_loops;
+    out.components = surface.components;
+    out.euler = surface.euler;
+    out.closed = surface.closed;
+  }
+  else {
+    out.boundary_loops = -1;
+    out.components = -1;
+    out.euler = 0;
+    out.closed = false;
+    const PointGrid holes(unseen, out.spacing);
+    for (std::size_t k = 0; k < out.points.size(); ++k) {
+      double dist = 0.0;
+      if (holes.nearest(out.points[k], 3.0 * out.spacing, -1, dist) >= 0)
+        out.near_boundary[k] = true;
+    }
+  }
+
+  // Noise, then the view's motion: a rotation about the centre by an angle that
+  // moves no point more than registration_error / 2 spacings, and a translation of
+  // that length.
+  std::size_t k = 0;
+  for (int v = 0; v < views; ++v) {
+    const std::size_t begin = k;
+    for (; k < kept.size() && out.view[k] == v; ++k)
+      out.points[k] += (rng.normal() * noise * out.spacing) * out.normals[k];
+    const double move = 0.5 * registration_error * out.spacing;
+    const Eigen::Vector3d axis = rng.unitVector();
+    const Eigen::Vector3d shift = move * rng.unitVector();
+    const Eigen::Vector2d half = portableCosSin(0.5 * move / extent);
+    const double qw = half.x();
+    const Eigen::Vector3d qv = half.y() * axis;
+    // The rotation matrix of the unit quaternion (qw, qv), row by row.
+    const double x = qv.x(), y = qv.y(), z = qv.z();
+    const Eigen::Vector3d rows[3] = {Eigen::Vector3d(1.0 - 2.0 * (y * y + z * z),
+                                                     2.0 * (x * y - qw * z),
+                                                     2.0 * (x * z + qw * y)),
+                                     Eigen::Vector3d(2.0 * (x * y + qw * z),
+                                                     1.0 - 2.0 * (x * x + z * z),
+                                                     2.0 * (y * z - qw * x)),
+                                     Eigen::Vector3d(2.0 * (x * z - qw * y),
+                                                     2.0 * (y * z + qw * x),
+                                                     1.0 - 2.0 * (x * x + y * y))};
+    for (std::size_t i = begin; i < k; ++i) {
+      const Eigen::Vector3d w = out.points[i] - centre;
+      out.points[i] =
+          centre +
+          Eigen::Vector3d(dot3(rows[0], w), dot3(rows[1], w), dot3(rows[2], w)) + shift;
+    }
+  }
+  return out;
+}
+
+Sample
+withOutliers(Sample s, double fraction, double max_offset_spacings, std::uint64_t seed)
+{
+  if (!(fraction >= 0.0 && fraction <= 1.0))
+    throw std::invalid_argument("cocone_test: fraction must be in [0, 1]");
+  if (!(max_offset_spacings >= 1.0) || !std::isfinite(max_offset_spacings))
+    throw std::invalid_argument("cocone_test: max_offset_spacings must be >= 1");
+  const std::size_t n = s.points.size();
+  s.outlier.resize(n, false);
+  s.near_boundary.resize(n, false);
+  s.component.resize(n, 0);
+  Rng rng(seed);
+  const auto count = static_cast<std::size_t>(fraction * double(n) + 0.5);
+  for (const std::size_t i : randomSubset(n, count, rng)) {
+    const double offset = rng.uniform(1.0, max_offset_spacings) * s.spacing;
+    const double side = rng.uniform01() < 0.5 ? -1.0 : 1.0;
+    s.points[i] += (side * offset) * s.normals[i];
+    s.outlier[i] = true;
+    s.near_boundary[i] = false;
+    s.component[i] = -1;
+  }
+  return s;
+}
+
+Sample
+withScatteredOutliers(Sample s, double fraction, std::uint64_t seed)
+{
+  if (!(fraction >= 0.0) || !std::isfinite(fraction))
+    throw std::invalid_argument("cocone_test: fraction must be >= 0");
+  const std::size_t n = s.points.size();
+  if (n == 0)
+    return s;
+  s.outlier.resize(n, false);
+  s.near_boundary.resize(n, false);
+  s.component.resize(n, 0);
+  Eigen::Vector3d lo, hi;
+  boundingBox(s.points, lo, hi);
+  const double margin = 0.05 * (hi - lo).maxCoeff();
+  lo -= Eigen::Vector3d::Constant(margin);
+  hi += Eigen::Vector3d::Constant(margin);
+  Rng rng(seed);
+  const auto count = static_cast<std::size_t>(fraction * double(n) + 0.5);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double x = rng.uniform(lo.x(), hi.x());
+    const double y = rng.uniform(lo.y(), hi.y());
+    const double z = rng.uniform(lo.z(), hi.z());
+    s.points.emplace_back(x, y, z);
+    s.normals.push_back(Eigen::Vector3d::Zero());
+    s.outlier.push_back(true);
+    s.near_boundary.push_back(false);
+    s.component.push_back(-1);
+    if (!s.view.empty())
+      s.view.push_back(-1);
+  }
+  return s;
 }
 
 } // namespace cocone_test
