@@ -6,12 +6,13 @@
  * library next to CGAL's Delaunay triangulation alone (the floor: no Delaunay-based
  * method can be faster) and to other reconstruction and border detection methods.
  *
- *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED]
+ *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED [NOISE]]
  *   cocone_benchmark convert CLOUD OUT.ply
  *   cocone_benchmark METHOD CLOUD [--truth auto|closed|saddle|none] [--threads T]
  *
  * generate writes seeded samples (area-uniform random or evenly spaced) of the torus
- * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2; convert writes the finite
+ * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2, with Gaussian noise of NOISE
+ * sample spacings along the normal; convert writes the finite
  * points of any readable cloud; both as binary PLY of float x, y, z (what the Open3D
  * script reads). METHOD is one of
  *   delaunay             CGAL::Delaunay_triangulation_3 of the points
@@ -276,10 +277,18 @@ cocone(const std::vector<Eigen::Vector3d>& points,
   const auto& t = r.timings;
   out.stages = {{"unique", t.unique / 1e3},
                 {"delaunay", t.delaunay / 1e3},
+                {"noise", t.noise / 1e3},
                 {"voronoi", t.voronoi / 1e3},
                 {"boundary", t.boundary / 1e3}};
-  char extra[96];
-  std::snprintf(extra, sizeof(extra), "rho=%.2f threads=%u", r.ratio, threads);
+  char extra[160];
+  std::snprintf(extra,
+                sizeof(extra),
+                "rho=%.2f noise=%.3f smoothed=%d outliers=%zu threads=%u",
+                r.ratio,
+                r.noise_level,
+                int(r.smoothed),
+                r.outlier_indices.size(),
+                threads);
   out.extra = extra;
   if (!reconstruct) {
     out.has_border = true;
@@ -327,7 +336,7 @@ int
 usage(const char* program)
 {
   std::fprintf(stderr,
-               "usage: %s generate torus|saddle random|even N OUT.ply [SEED]\n"
+               "usage: %s generate torus|saddle random|even N OUT.ply [SEED [NOISE]]\n"
                "       %s convert CLOUD OUT.ply\n"
                "       %s delaunay|detect|cocone|gp3|boundary_estimation|"
                "advancing_front CLOUD\n"
@@ -347,6 +356,7 @@ generate(int argc, char** argv)
   cocone_test::SampleOptions o;
   o.n = std::strtoul(argv[4], nullptr, 10);
   o.seed = argc > 6 ? std::strtoull(argv[6], nullptr, 10) : 1;
+  o.noise = argc > 7 ? std::strtod(argv[7], nullptr) : 0.0;
   o.even = sampling == "even";
   if ((surface != "torus" && surface != "saddle") ||
       (sampling != "even" && sampling != "random"))

@@ -7,6 +7,7 @@
 #include <pcl/surface/cocone/candidates.h>
 #include <pcl/surface/cocone/complex.h>
 #include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/noise.h>
 #include <pcl/surface/cocone/pipeline.h>
 #include <pcl/surface/cocone/pruning.h>
 #include <pcl/surface/cocone/repair.h>
@@ -142,6 +143,69 @@ reconstruct(Triangulation& dt,
   }
 }
 
+/** Noise handling between the first pass over the cells and the rest: the noise
+ * levels, and where there are outliers or noise, the triangulation and the first pass
+ * again, of the smoothed points without the outliers. Returns whether it replaced
+ * them; false with result.error set if the points left are too few. */
+bool
+handleNoise(Triangulation& dt,
+            VoronoiCells& cells,
+            const Parameters& parameters,
+            Result& result,
+            int threads)
+{
+  if (cells.nearest.size() != dt.points.size())
+    return false; // no neighbour lists (coplanar points): nothing to read
+  const NoiseAnalysis noise = analyzeNoise(dt.points, cells.nearest, threads);
+  result.noise_level = noise.cloud_level;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  result.point_noise.assign(result.vertex_of_input.size(), nan);
+  for (std::size_t i = 0; i < result.vertex_of_input.size(); ++i)
+    if (result.vertex_of_input[i] >= 0)
+      result.point_noise[i] = noise.level[result.vertex_of_input[i]];
+  result.smoothed = noise.cloud_level > parameters.noise_threshold;
+  if (!result.smoothed && noise.outliers == 0)
+    return false; // a clean cloud: the triangulation stands
+  std::vector<Eigen::Vector3d> kept =
+      result.smoothed ? smoothPoints(dt.points,
+                                     cells.nearest,
+                                     noise.outlier,
+                                     std::max(parameters.smoothing_iterations, 1),
+                                     threads)
+                      : std::move(dt.points);
+  cells = VoronoiCells();
+  dt.release();
+  // The kept points, back in the caller's frame, renumbered by makeUniquePoints()
+  // (smoothing may bring two points together).
+  std::vector<int> kept_index(kept.size(), -2);
+  std::size_t k = 0;
+  for (std::size_t v = 0; v < kept.size(); ++v)
+    if (!noise.outlier[v]) {
+      kept_index[v] = static_cast<int>(k);
+      kept[k++] = kept[v] + dt.offset;
+    }
+  kept.resize(k);
+  UniquePoints unique = makeUniquePoints(kept, threads);
+  std::vector<Eigen::Vector3d>().swap(kept);
+  for (int& v : result.vertex_of_input)
+    if (v >= 0)
+      v = kept_index[v] < 0 ? -2 : unique.vertex_of_input[kept_index[v]];
+  result.vertices = unique.points.size();
+  if (unique.points.size() < 4) {
+    result.error = "fewer than 4 distinct finite points that are not outliers (" +
+                   std::to_string(unique.points.size()) + ")";
+    return false;
+  }
+  dt = triangulate(std::move(unique.points), threads);
+  if (dt.dimension < 2) {
+    result.error = "the points that are not outliers are collinear";
+    return false;
+  }
+  result.offset = dt.offset;
+  cells = computePoles(dt, parameters.cocone_angle, parameters.threads);
+  return true;
+}
+
 Result
 runStages(std::vector<Eigen::Vector3d>&& points,
           const Parameters& parameters,
@@ -175,6 +239,10 @@ runStages(std::vector<Eigen::Vector3d>&& points,
 
   VoronoiCells cells = computePoles(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
+  if (parameters.noise_handling &&
+      !handleNoise(dt, cells, parameters, result, threads) && !result.error.empty())
+    return result;
+  result.timings.noise = clock.lap();
 
   // Stage 3 in two parts: what reads the nearest neighbours (the local spacing and
   // the half-disk test, which need only the poles) before the second Voronoi pass,
@@ -234,6 +302,8 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   result.representative.assign(result.vertices, std::numeric_limits<int>::max());
   for (std::size_t i = 0; i < result.vertex_of_input.size(); ++i) {
     const int v = result.vertex_of_input[i];
+    if (v == -2)
+      result.outlier_indices.push_back(id(i));
     if (v < 0)
       continue;
     result.representative[v] = std::min(result.representative[v], id(i));
@@ -241,6 +311,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
       result.boundary_indices.push_back(id(i));
   }
   std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
+  std::sort(result.outlier_indices.begin(), result.outlier_indices.end());
   result.polygons.reserve(result.triangles.size());
   for (const auto& t : result.triangles)
     result.polygons.push_back({result.representative[t[0]],

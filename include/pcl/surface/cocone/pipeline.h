@@ -43,6 +43,16 @@ struct Parameters {
   /** Close border loops of at most this many edges with Delaunay triangles: holes
    * below the sampling resolution (one or a few missing triangles); 0: none. */
   std::size_t fill_hole_edges = 6;
+  /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
+   * cloud's noise level exceeds noise_threshold every decision is taken on a
+   * smoothed copy of the points (smoothPoints()), the mesh still indexing the
+   * caller's points. false: the points as given. */
+  bool noise_handling = true;
+  /** The cloud noise level (about sigma in sample spacings) above which the
+   * decisions are taken on smoothed points. */
+  double noise_threshold = 0.1;
+  /** Projections onto local jets when smoothing. */
+  int smoothing_iterations = 2;
   /** Threads for the parallel stages, 0 for all processors; the output does not
    * depend on it. */
   unsigned int threads = 1;
@@ -64,6 +74,7 @@ struct ReconstructionCounts {
 struct Timings {
   double unique = 0.0;         ///< merging duplicates, numbering the vertices
   double delaunay = 0.0;       ///< stage 1
+  double noise = 0.0;          ///< noise analysis, smoothing, second triangulation
   double voronoi = 0.0;        ///< stage 2
   double boundary = 0.0;       ///< stage 3
   double reconstruction = 0.0; ///< stages 4-7 and the repair
@@ -77,8 +88,19 @@ struct Timings {
 struct Result {
   /** Empty on success; otherwise why there is no result. */
   std::string error;
-  /** Per point passed to run(): its Delaunay vertex, -1 if the point is not finite. */
+  /** Per point passed to run(): its Delaunay vertex, -1 if the point is not finite,
+   * -2 if it is an outlier. */
   std::vector<int> vertex_of_input;
+  /** The noise level of the cloud (NoiseAnalysis::cloud_level; 0 without noise
+   * handling). */
+  double noise_level = 0.0;
+  /** Per point passed to run(): its noise level (NoiseAnalysis::level), NaN if it
+   * is not finite; empty without noise handling. */
+  std::vector<float> point_noise;
+  /** The decisions were taken on smoothed points: positions are the smoothed ones. */
+  bool smoothed = false;
+  /** Caller ids of the outliers, ascending: set aside, in no triangle. */
+  std::vector<int> outlier_indices;
   /** Number of Delaunay vertices (unique finite points). */
   std::size_t vertices = 0;
   /** Per vertex: undersampled (not in the interior set of stage 3), or a rim point
@@ -93,7 +115,8 @@ struct Result {
   std::vector<int> boundary_indices;
   /** Per vertex: the caller id that stands for it in polygons (its lowest). */
   std::vector<int> representative;
-  /** Vertex positions, recentred: a point is positions[v] + offset. */
+  /** Vertex positions, recentred: a point is positions[v] + offset. The smoothed
+   * positions when smoothed is set. */
   std::vector<Eigen::Vector3d> positions;
   /** The offset subtracted before triangulating. */
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();

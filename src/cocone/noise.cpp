@@ -1,0 +1,386 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/noise.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "parallel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace pcl {
+namespace cocone {
+
+namespace {
+
+constexpr int NEAREST = VoronoiCells::NEAREST;
+constexpr std::size_t TWO_RING = std::size_t(NEAREST) * (NEAREST + 1);
+/** Neighbours of the local spacing, as in localSpacing(). */
+constexpr int SPACING_NEIGHBOURS = 6;
+/** Neighbourhood of the smoothing: CGAL's default for jet fitting. */
+constexpr int SMOOTHING_NEIGHBOURS = 24;
+/** Turns sqrt(mean square off the plane / spread along it) over a point and its
+ * nearest Delaunay neighbours into sigma in spacings: measured on random samples
+ * with Gaussian noise of 0.3, 0.5 and 1 spacing. */
+constexpr double LEVEL_SCALE = 3.8;
+/** Rounds of the outlier search at most. */
+constexpr int OUTLIER_ROUNDS = 3;
+
+/** Least-squares plane of points given by their sums relative to an origin: the
+ * centroid, the unit normal and the mean squared distance to the plane. */
+struct Plane {
+  Eigen::Vector3d centroid;
+  Eigen::Vector3d normal;
+  Eigen::Vector3d tangent_u, tangent_v;
+  double mean_square = 0.0;
+  /** Mean squared distance from the centroid along the plane. */
+  double spread = 0.0;
+};
+
+Plane
+fitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, int count)
+{
+  Plane plane;
+  plane.centroid = sum / count;
+  const Eigen::Matrix3d covariance =
+      outer / count - plane.centroid * plane.centroid.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
+  // Ascending eigenvalues: the smallest's vector is the normal.
+  plane.normal = solver.eigenvectors().col(0);
+  plane.tangent_u = solver.eigenvectors().col(2);
+  plane.tangent_v = solver.eigenvectors().col(1);
+  plane.mean_square = std::max(solver.eigenvalues()(0), 0.0);
+  plane.spread = solver.eigenvalues()(1) + solver.eigenvalues()(2);
+  return plane;
+}
+
+int
+count(const std::array<int, NEAREST>& near)
+{
+  int c = 0;
+  while (c < NEAREST && near[c] >= 0)
+    ++c;
+  return c;
+}
+
+template <typename T>
+T
+median(std::vector<T> values)
+{
+  if (values.empty())
+    return T(0);
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+/** Least-squares degree-2 jet: a quadratic height field w(u, v) over the plane of
+ * the points, u and v scaled by the neighbourhood's radius so that the normal
+ * equations stay well conditioned. */
+class Jet {
+public:
+  /** The jet of \a P[i] - origin over \a neighbours, and of the origin itself when
+   * \a with_origin. */
+  Jet(const std::vector<Eigen::Vector3d>& P,
+      const Eigen::Vector3d& origin,
+      const int* neighbours,
+      int k,
+      bool with_origin)
+  : origin_(origin)
+  {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    double radius2 = 0.0;
+    for (int i = 0; i < k; ++i) {
+      const Eigen::Vector3d q = P[neighbours[i]] - origin;
+      sum += q;
+      outer += q * q.transpose();
+      radius2 = std::max(radius2, q.squaredNorm());
+    }
+    const int points = k + (with_origin ? 1 : 0);
+    if (points < 3 || radius2 == 0.0)
+      return;
+    plane_ = fitPlane(sum, outer, points); // the origin adds zeros
+    planar_ = true;
+    mean_square_ = plane_.mean_square;
+    if (points > 3)
+      sigma_ = std::sqrt(mean_square_ * points / (points - 3));
+    // Twice the jet's six coefficients at least, or the fit follows the noise.
+    if (points < 12)
+      return;
+    scale_ = 1.0 / std::sqrt(radius2);
+    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    double heights2 = 0.0;
+    const auto add = [&](const Eigen::Vector3d& q) {
+      const Eigen::Vector3d d = q - plane_.centroid;
+      const Eigen::Matrix<double, 6, 1> b = basis(d);
+      const double w = d.dot(plane_.normal);
+      normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(b);
+      rhs += b * w;
+      heights2 += w * w;
+    };
+    if (with_origin)
+      add(Eigen::Vector3d::Zero());
+    for (int i = 0; i < k; ++i)
+      add(P[neighbours[i]] - origin);
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(
+        normal_matrix.selfadjointView<Eigen::Lower>());
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+        !(ldlt.vectorD().minCoeff() > 1e-9 * ldlt.vectorD().maxCoeff()))
+      return;
+    coefficients_ = ldlt.solve(rhs);
+    // The residual sum of squares of a least-squares fit: |w|^2 - c . (A^T w).
+    const double residual = (heights2 - coefficients_.dot(rhs)) / points;
+    if (!coefficients_.allFinite() || !std::isfinite(residual))
+      return;
+    curved_ = true;
+    mean_square_ = std::max(residual, 0.0);
+    sigma_ = std::sqrt(mean_square_ * points / (points - 6));
+  }
+
+  /** The point of the jet above or below \a x (of the plane where the jet is not
+   * determined); x itself without a plane. */
+  Eigen::Vector3d
+  project(const Eigen::Vector3d& x) const
+  {
+    if (!planar_)
+      return x;
+    const Eigen::Vector3d d = x - origin_ - plane_.centroid;
+    const double height = curved_ ? basis(d).dot(coefficients_) : 0.0;
+    return x + (height - d.dot(plane_.normal)) * plane_.normal;
+  }
+
+  /** Mean squared distance of the points to the jet (to the plane where the jet is
+   * not determined). */
+  double
+  meanSquare() const
+  {
+    return mean_square_;
+  }
+
+  /** The noise's standard deviation about the jet (the plane where the jet is not
+   * determined): the residual with the fit's degrees of freedom taken out. */
+  double
+  sigma() const
+  {
+    return sigma_;
+  }
+
+  /** Mean squared distance of the points from their centroid along the plane. */
+  double
+  spread() const
+  {
+    return plane_.spread;
+  }
+
+private:
+  Eigen::Matrix<double, 6, 1>
+  basis(const Eigen::Vector3d& d) const
+  {
+    const double u = d.dot(plane_.tangent_u) * scale_,
+                 v = d.dot(plane_.tangent_v) * scale_;
+    Eigen::Matrix<double, 6, 1> b;
+    b << 1.0, u, v, u * u, u * v, v * v;
+    return b;
+  }
+
+  Eigen::Vector3d origin_;
+  Plane plane_;
+  double scale_ = 1.0;
+  Eigen::Matrix<double, 6, 1> coefficients_ = Eigen::Matrix<double, 6, 1>::Zero();
+  double mean_square_ = 0.0;
+  double sigma_ = std::numeric_limits<double>::infinity();
+  bool planar_ = false, curved_ = false;
+};
+
+/** One round of analyzeNoise() over neighbour lists that leave out the outliers
+ * found so far: the levels (in the first round) and the new outliers. */
+void
+noiseRound(const std::vector<Eigen::Vector3d>& points,
+           const std::vector<std::array<int, NEAREST>>& lists,
+           bool levels,
+           int threads,
+           NoiseAnalysis& out)
+{
+  const auto n = static_cast<std::ptrdiff_t>(points.size());
+  // Per vertex: how many of its nearest neighbours are near (see below), their mean
+  // spacing, p's distance to their plane and whether p stands beside them rather
+  // than off their plane.
+  std::vector<std::uint8_t> near(n, 0), beside(n, 0);
+  std::vector<float> spacing(n, 0.0f), offset(n, 0.0f);
+  std::vector<std::uint8_t> found(n, 0);
+#pragma omp parallel for num_threads(threads) schedule(static, 4096)
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    const int c = count(lists[p]);
+    double distance = 0.0;
+    for (int i = 0; i < std::min(c, SPACING_NEIGHBOURS); ++i)
+      distance += (points[lists[p][i]] - points[p]).norm();
+    spacing[p] =
+        static_cast<float>(c ? distance / std::min(c, SPACING_NEIGHBOURS) : 0.0);
+    // Near: within three spacings. The Delaunay neighbours of a surface sample
+    // include long edges across the inside or the outside, which are not the
+    // surface's.
+    const double reach2 = 9.0 * double(spacing[p]) * spacing[p];
+    int k = 0;
+    while (k < c && (points[lists[p][k]] - points[p]).squaredNorm() <= reach2)
+      ++k;
+    near[p] = static_cast<std::uint8_t>(k);
+    if (k < 3)
+      continue;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < k; ++i) {
+      const Eigen::Vector3d q = points[lists[p][i]] - points[p];
+      sum += q;
+      outer += q * q.transpose();
+    }
+    const Plane without = fitPlane(sum, outer, k);
+    const double normal_offset = std::abs(without.normal.dot(without.centroid));
+    offset[p] = static_cast<float>(normal_offset);
+    beside[p] =
+        (without.centroid - without.normal.dot(without.centroid) * without.normal)
+            .norm() > normal_offset;
+    // The noise against the spread along the surface, which the noise does not
+    // inflate as it does the distances; off the jet rather than the plane, which
+    // would read a coarse sample's curvature as noise.
+    if (!levels)
+      continue;
+    const Jet jet(points, points[p], lists[p].data(), k, true);
+    if (jet.spread() > 0.0)
+      out.level[p] =
+          static_cast<float>(LEVEL_SCALE * std::sqrt(jet.meanSquare() / jet.spread()));
+  }
+  if (levels)
+    out.cloud_level = median(out.level);
+
+    // An outlier stands off the jet of its neighbours without it by half their
+    // spacing and by 6 sigma of the noise about that jet: neither the curvature,
+    // which the jet follows, nor p, which the jet leaves out, raises them. Only a
+    // point off the plane of its neighbours is a candidate (the jet is the expensive
+    // part), and only a point above them rather than beside them, which is how a point
+    // at a border sees its neighbours' fit, extrapolated, miss it; unless p is
+    // isolated, its spacing three times its neighbours'.
+#pragma omp parallel for num_threads(threads) schedule(static, 4096)
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    const int k = near[p];
+    if (k < 3 || out.outlier[p])
+      continue;
+    std::array<float, NEAREST> around;
+    for (int i = 0; i < k; ++i)
+      around[i] = spacing[lists[p][i]];
+    std::nth_element(around.begin(), around.begin() + k / 2, around.begin() + k);
+    const double around_spacing = around[k / 2];
+    if (!(offset[p] > 0.25 * around_spacing) ||
+        (beside[p] && !(spacing[p] > 3.0 * around_spacing)))
+      continue;
+    const Jet jet(points, points[p], lists[p].data(), k, false);
+    const double off = (jet.project(points[p]) - points[p]).norm();
+    found[p] = off > 0.25 * around_spacing && off > 6.0 * jet.sigma();
+  }
+  for (std::ptrdiff_t p = 0; p < n; ++p)
+    out.outlier[p] |= found[p];
+}
+
+} // namespace
+
+NoiseAnalysis
+analyzeNoise(const std::vector<Eigen::Vector3d>& points,
+             const std::vector<std::array<int, NEAREST>>& nearest,
+             int threads)
+{
+  const auto n = points.size();
+  NoiseAnalysis out;
+  out.level.assign(n, 0.0f);
+  out.outlier.assign(n, 0);
+  noiseRound(points, nearest, true, threads, out);
+  // Outliers next to each other hide one another: they are looked for again among
+  // the neighbours that are not outliers, until no new one is found.
+  for (int round = 1; round < OUTLIER_ROUNDS; ++round) {
+    const std::size_t found = std::count(out.outlier.begin(), out.outlier.end(), 1);
+    if (found == out.outliers)
+      break;
+    out.outliers = found;
+    std::vector<std::array<int, NEAREST>> lists(n);
+    for (std::size_t p = 0; p < n; ++p) {
+      int k = 0;
+      for (const int q : nearest[p])
+        if (q >= 0 && !out.outlier[q])
+          lists[p][k++] = q;
+      std::fill(lists[p].begin() + k, lists[p].end(), -1);
+    }
+    noiseRound(points, lists, false, threads, out);
+  }
+  out.outliers = std::count(out.outlier.begin(), out.outlier.end(), 1);
+  return out;
+}
+
+std::vector<Eigen::Vector3d>
+smoothPoints(const std::vector<Eigen::Vector3d>& points,
+             const std::vector<std::array<int, NEAREST>>& nearest,
+             const std::vector<std::uint8_t>& outlier,
+             int iterations,
+             int threads)
+{
+  const auto n = static_cast<std::ptrdiff_t>(points.size());
+  const auto is_outlier = [&](int q) { return !outlier.empty() && outlier[q]; };
+  // The neighbourhoods: the K nearest of the two-ring, by distance, then id.
+  constexpr int K = SMOOTHING_NEIGHBOURS;
+  std::vector<int> neighbours(static_cast<std::size_t>(n) * K, -1);
+  std::vector<int> size(n, 0);
+  detail::forEachRange(
+      n, detail::partsFor(n, threads), [&](std::size_t begin, std::size_t end, int) {
+        // Per part: the last vertex whose ring each vertex joined (no sort to drop the
+        // duplicates of a ring, which holds each neighbour several times).
+        std::vector<int> seen(n, -1);
+        std::array<std::pair<double, int>, TWO_RING> ring;
+        for (std::size_t p = begin; p < end; ++p) {
+          if (is_outlier(static_cast<int>(p)))
+            continue;
+          int r = 0;
+          seen[p] = static_cast<int>(p);
+          const auto offer = [&](int q) {
+            if (seen[q] != static_cast<int>(p) && !is_outlier(q)) {
+              seen[q] = static_cast<int>(p);
+              ring[r++] = {(points[q] - points[p]).squaredNorm(), q};
+            }
+          };
+          for (const int q : nearest[p]) {
+            if (q < 0)
+              break;
+            offer(q);
+            for (const int s : nearest[q]) {
+              if (s < 0)
+                break;
+              offer(s);
+            }
+          }
+          size[p] = std::min(r, K);
+          std::nth_element(ring.begin(), ring.begin() + size[p], ring.begin() + r);
+          std::sort(ring.begin(), ring.begin() + size[p]);
+          for (int i = 0; i < size[p]; ++i)
+            neighbours[p * K + i] = ring[i].second;
+        }
+      });
+
+  std::vector<Eigen::Vector3d> current = points, next(points.size());
+  for (int it = 0; it < iterations; ++it) {
+#pragma omp parallel for num_threads(threads) schedule(static, 4096)
+    for (std::ptrdiff_t p = 0; p < n; ++p)
+      next[p] = Jet(current, current[p], &neighbours[p * K], size[p], true)
+                    .project(current[p]);
+    std::swap(current, next);
+  }
+  return current;
+}
+
+} // namespace cocone
+} // namespace pcl
