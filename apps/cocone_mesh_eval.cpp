@@ -1,0 +1,417 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * cocone_mesh_eval: the topology of the reconstruction of closed reference shapes,
+ * next to CGAL's advancing front, as a Markdown table.
+ *
+ *   cocone_mesh_eval [--threads T] [--no-peer] FILE[:EULER] ...
+ *
+ * e.g. cocone_mesh_eval ../shared/data/closed_meshes/bunny.obj
+ *        ../shared/data/powercrust_samples/knot.pts:0
+ *
+ * A Wavefront .obj with faces is a mesh: its vertices (all of them, referenced or
+ * not) are the cloud, and its faces the truth: the Euler characteristic V - E + F
+ * over the referenced vertices, the components (through shared edges), the boundary
+ * edges (none: a closed shape) and the genus (2 components - Euler) / 2. Any other
+ * cloud (.pts, .xyz, .ply, .pcd, an .obj without faces) has only the Euler
+ * characteristic given after the name (FILE:EULER; "?" or none: unknown).
+ *
+ * Each cloud goes to this library with the default parameters (threads from
+ * --threads, 1 if not given) and to CGAL::advancing_front_surface_reconstruction with
+ * its defaults (not with --no-peer). Per method the table gives the mesh's vertices,
+ * triangles, components, Euler characteristic, whether it is an oriented 2-manifold
+ * and closed, its border loops (all wrong: the truth has none) with the edge counts
+ * of the 5 largest and the median, the outliers the library set aside, and the
+ * seconds. The peer's loops are the cycles of its boundary edges. The last column
+ * says whether this library has at most as many wrong loops as the peer.
+ */
+
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/pipeline.h>
+
+#include "benchmark_advancing_front.h"
+#include "cloud_io.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using pcl::cocone::MeshTopology;
+using pcl::cocone::Triangle;
+
+double
+since(std::chrono::steady_clock::time_point t)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/** What is known of the true surface of a cloud. */
+struct Truth {
+  bool mesh = false;            ///< from the faces of an .obj
+  bool euler_known = false;     ///< the Euler characteristic is known
+  long euler = 0;               ///< V - E + F
+  MeshTopology topology;        ///< of the faces (mesh only)
+  std::size_t unreferenced = 0; ///< vertices in no face (mesh only)
+};
+
+/** Read the faces of a Wavefront file as triangles (polygons as fans) over its
+ * vertex lines, numbered from 0; negative indices count back from the last vertex
+ * read. False, and why in \a error, if a face names a missing vertex. */
+bool
+readObjFaces(const std::string& path,
+             std::vector<Triangle>& triangles,
+             std::size_t& vertices,
+             std::string& error)
+{
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot read '" + path + "'";
+    return false;
+  }
+  vertices = 0;
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos)
+      line.resize(hash);
+    std::istringstream fields(line);
+    std::string tag;
+    if (!(fields >> tag))
+      continue;
+    if (tag == "v") {
+      ++vertices;
+      continue;
+    }
+    if (tag != "f")
+      continue;
+    std::vector<int> face;
+    std::string corner;
+    while (fields >> corner) {
+      // v, v/vt, v//vn or v/vt/vn: the vertex is the first number.
+      char* end = nullptr;
+      const long i = std::strtol(corner.c_str(), &end, 10);
+      const long v = i > 0 ? i - 1 : static_cast<long>(vertices) + i;
+      if (end == corner.c_str() || i == 0 || v < 0 ||
+          v >= static_cast<long>(vertices)) {
+        error = "line " + std::to_string(number) + ": bad vertex '" + corner + "'";
+        return false;
+      }
+      face.push_back(static_cast<int>(v));
+    }
+    for (std::size_t k = 2; k < face.size(); ++k)
+      triangles.push_back({face[0], face[k - 1], face[k]});
+  }
+  return true;
+}
+
+/** The border loops of a triangle mesh of any kind: the cycles of its directed
+ * boundary half-edges (edges in one triangle, as that triangle traverses them).
+ * Where several loops pass through a vertex they are split there; a chain that
+ * cannot close (the triangles around it disagree in orientation) counts as a loop
+ * too. Each loop is its vertices, as many as its edges. */
+std::vector<std::vector<int>>
+borderCycles(const std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  const pcl::cocone::EdgeIncidences inc(triangles);
+  // Outgoing border half-edges per vertex, in CSR form.
+  std::vector<std::array<int, 2>> half;
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1) {
+      const std::size_t i = inc.first[e];
+      const bool forward = inc.forward[i] != 0;
+      half.push_back({inc.edges[e][forward ? 0 : 1], inc.edges[e][forward ? 1 : 0]});
+    }
+  std::sort(half.begin(), half.end());
+  std::vector<std::size_t> first(num_vertices + 1, 0);
+  for (const auto& h : half)
+    ++first[h[0] + 1];
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    first[v + 1] += first[v];
+  std::vector<std::size_t> next_unused(first.begin(), first.end() - 1);
+  std::vector<std::vector<int>> loops;
+  for (std::size_t s = 0; s < half.size(); ++s) {
+    const int start = half[s][0];
+    if (next_unused[start] == first[start + 1])
+      continue; // every half-edge out of start is on a loop
+    std::vector<int> loop;
+    int v = start;
+    do {
+      loop.push_back(v);
+      const int w = half[next_unused[v]++][1];
+      v = w;
+    }
+    while (v != start && next_unused[v] < first[v + 1]);
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+/** One row of the table. */
+struct Row {
+  std::string error;
+  std::size_t mesh_vertices = 0;
+  MeshTopology topology;
+  std::vector<std::size_t> loop_sizes; ///< edges per loop
+  long outliers = -1;                  ///< -1: not reported
+  double seconds = 0.0;
+};
+
+template <class Loops>
+std::vector<std::size_t>
+sizes(const Loops& loops)
+{
+  std::vector<std::size_t> s;
+  for (const auto& l : loops)
+    s.push_back(l.size());
+  return s;
+}
+
+Row
+runCocone(const std::vector<Eigen::Vector3d>& points, unsigned int threads)
+{
+  Row row;
+  pcl::cocone::Parameters parameters;
+  parameters.threads = threads;
+  const auto t = std::chrono::steady_clock::now();
+  const pcl::cocone::Result r =
+      pcl::cocone::run(points, parameters, pcl::cocone::Stages::RECONSTRUCTION);
+  row.seconds = since(t);
+  if (!r.error.empty()) {
+    row.error = r.error;
+    return row;
+  }
+  row.topology = pcl::cocone::analyzeMesh(r.triangles, r.vertices);
+  row.loop_sizes = sizes(r.border_loops);
+  row.outliers = static_cast<long>(r.outlier_indices.size());
+  return row;
+}
+
+Row
+runPeer(const std::vector<Eigen::Vector3d>& points)
+{
+  Row row;
+  const auto t = std::chrono::steady_clock::now();
+  const std::vector<Triangle> triangles = cocone_app::advancingFront(points);
+  row.seconds = since(t);
+  row.topology = pcl::cocone::analyzeMesh(triangles, points.size());
+  row.loop_sizes = sizes(borderCycles(triangles, points.size()));
+  return row;
+}
+
+std::string
+yesNo(bool b)
+{
+  return b ? "yes" : "no";
+}
+
+/** The edge counts of the 5 largest loops, and the median one. */
+void
+loopSummary(std::vector<std::size_t> s, std::string& largest, std::string& median)
+{
+  if (s.empty()) {
+    largest = median = "-";
+    return;
+  }
+  std::sort(s.begin(), s.end(), std::greater<std::size_t>());
+  largest.clear();
+  for (std::size_t i = 0; i < s.size() && i < 5; ++i)
+    largest += (i ? ", " : "") + std::to_string(s[i]);
+  const std::size_t n = s.size();
+  char buffer[32];
+  if (n % 2)
+    std::snprintf(buffer, sizeof(buffer), "%zu", s[n / 2]);
+  else
+    std::snprintf(buffer, sizeof(buffer), "%g", 0.5 * double(s[n / 2 - 1] + s[n / 2]));
+  median = buffer;
+}
+
+std::string
+truthText(const Truth& t)
+{
+  if (!t.mesh)
+    return t.euler_known ? "Euler " + std::to_string(t.euler) + " (given)" : "Euler ?";
+  const MeshTopology& m = t.topology;
+  std::string s = "Euler " + std::to_string(m.euler) + ", " +
+                  std::to_string(m.components) + " comp.";
+  if (m.boundary_edges == 0) {
+    const long twice = 2 * static_cast<long>(m.components) - m.euler;
+    s += twice % 2 ? ", genus ?" : ", genus " + std::to_string(twice / 2);
+  }
+  else
+    s += ", " + std::to_string(m.boundary_edges) + " boundary edges (not closed)";
+  if (!m.manifold())
+    s += ", not manifold";
+  if (t.unreferenced)
+    s += ", " + std::to_string(t.unreferenced) + " unreferenced vertices";
+  return s;
+}
+
+void
+printRow(const std::string& cloud,
+         const std::string& truth,
+         const char* method,
+         std::size_t points,
+         const Row& row,
+         const std::string& verdict)
+{
+  if (!row.error.empty()) {
+    std::printf("| %s | %s | %s | %zu | error: %s | | | | | | | | | | %.2f | %s |\n",
+                cloud.c_str(),
+                truth.c_str(),
+                method,
+                points,
+                row.error.c_str(),
+                row.seconds,
+                verdict.c_str());
+    return;
+  }
+  const MeshTopology& m = row.topology;
+  std::string largest, median;
+  loopSummary(row.loop_sizes, largest, median);
+  std::printf(
+      "| %s | %s | %s | %zu | %zu | %zu | %zu | %ld | %s | %s | %zu | %s | %s | %s | "
+      "%.2f | %s |\n",
+      cloud.c_str(),
+      truth.c_str(),
+      method,
+      points,
+      m.vertices,
+      m.triangles,
+      m.components,
+      m.euler,
+      yesNo(m.manifold()).c_str(),
+      yesNo(m.triangles > 0 && m.boundary_edges == 0).c_str(),
+      row.loop_sizes.size(),
+      largest.c_str(),
+      median.c_str(),
+      row.outliers < 0 ? "-" : std::to_string(row.outliers).c_str(),
+      row.seconds,
+      verdict.c_str());
+}
+
+/** Split FILE:EULER; the suffix counts only if it is an integer or "?". */
+void
+splitArgument(const std::string& arg, std::string& path, Truth& truth)
+{
+  path = arg;
+  const auto colon = arg.find_last_of(':');
+  if (colon == std::string::npos)
+    return;
+  const std::string suffix = arg.substr(colon + 1);
+  if (suffix == "?") {
+    path = arg.substr(0, colon);
+    return;
+  }
+  char* end = nullptr;
+  const long e = std::strtol(suffix.c_str(), &end, 10);
+  if (suffix.empty() || *end != '\0')
+    return;
+  path = arg.substr(0, colon);
+  truth.euler_known = true;
+  truth.euler = e;
+}
+
+std::string
+baseName(const std::string& path)
+{
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  unsigned int threads = 1;
+  bool peer = true;
+  std::vector<std::string> files;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    if (arg == "--threads" && a + 1 < argc)
+      threads = static_cast<unsigned int>(std::strtoul(argv[++a], nullptr, 10));
+    else if (arg == "--no-peer")
+      peer = false;
+    else if (arg.size() > 1 && arg[0] == '-') {
+      std::fprintf(stderr, "unknown option '%s'\n", arg.c_str());
+      return 1;
+    }
+    else
+      files.push_back(arg);
+  }
+  if (files.empty()) {
+    std::fprintf(
+        stderr, "usage: %s [--threads T] [--no-peer] FILE[:EULER] ...\n", argv[0]);
+    return 1;
+  }
+  std::printf("| cloud | truth | method | points | mesh vertices | triangles | "
+              "components | Euler | manifold | closed | wrong loops | largest loops "
+              "(edges) | median loop | outliers | s | ours <= peer |\n");
+  std::printf("|---|---|---|---:|---:|---:|---:|---:|---|---|---:|---|---:|---:|---:|"
+              "---|\n");
+  int status = 0;
+  for (const std::string& arg : files) {
+    std::string path;
+    Truth truth;
+    splitArgument(arg, path, truth);
+    pcl::PCLPointCloud2 blob;
+    std::string error;
+    std::vector<Eigen::Vector3d> points;
+    if (!cocone_app::readCloud(path, blob, error) ||
+        !cocone_app::extractXYZ(blob, points, error)) {
+      std::fprintf(stderr, "%s\n", error.c_str());
+      status = 1;
+      continue;
+    }
+    if (cocone_app::extension(path) == "obj") {
+      std::vector<Triangle> faces;
+      std::size_t vertices = 0;
+      if (!readObjFaces(path, faces, vertices, error)) {
+        std::fprintf(stderr, "%s: %s\n", path.c_str(), error.c_str());
+        status = 1;
+        continue;
+      }
+      if (!faces.empty()) {
+        if (truth.euler_known)
+          std::fprintf(stderr,
+                       "%s: a mesh; its faces' Euler characteristic is the truth\n",
+                       path.c_str());
+        truth.mesh = true;
+        truth.topology = pcl::cocone::analyzeMesh(faces, points.size());
+        truth.euler_known = true;
+        truth.euler = truth.topology.euler;
+        truth.unreferenced = points.size() - truth.topology.vertices;
+      }
+    }
+    const std::string name = baseName(path);
+    const std::string truth_text = truthText(truth);
+    std::fprintf(stderr, "%s: %zu points\n", path.c_str(), points.size());
+    const Row ours = runCocone(points, threads);
+    if (!peer) {
+      printRow(name, truth_text, "cocone", points.size(), ours, "-");
+      continue;
+    }
+    const Row theirs = runPeer(points);
+    const bool both = ours.error.empty() && theirs.error.empty();
+    printRow(name,
+             truth_text,
+             "cocone",
+             points.size(),
+             ours,
+             both ? yesNo(ours.loop_sizes.size() <= theirs.loop_sizes.size()) : "-");
+    printRow(name, truth_text, "advancing front", points.size(), theirs, "");
+  }
+  return status;
+}
