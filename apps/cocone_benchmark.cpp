@@ -283,9 +283,10 @@ cocone(const std::vector<Eigen::Vector3d>& points,
   char extra[160];
   std::snprintf(extra,
                 sizeof(extra),
-                "rho=%.2f noise=%.3f smoothed=%d outliers=%zu threads=%u",
+                "rho=%.2f noise=%.3f after=%.3f smoothed=%d outliers=%zu threads=%u",
                 r.ratio,
                 r.noise_level,
+                r.noise_after_smoothing,
                 int(r.smoothed),
                 r.outlier_indices.size(),
                 threads);

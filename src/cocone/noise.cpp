@@ -30,6 +30,8 @@ constexpr int SMOOTHING_NEIGHBOURS = 24;
  * nearest Delaunay neighbours into sigma in spacings: measured on random samples
  * with Gaussian noise of 0.3, 0.5 and 1 spacing. */
 constexpr double LEVEL_SCALE = 3.8;
+/** One point in this many has its noise level measured again after smoothing. */
+constexpr int RECHECK_STRIDE = 4;
 /** Rounds of the outlier search at most. */
 constexpr int OUTLIER_ROUNDS = 3;
 
@@ -159,6 +161,24 @@ public:
     return x + (height - d.dot(plane_.normal)) * plane_.normal;
   }
 
+  /** Signed distance of \a x to the jet (to the plane where the jet is not
+   * determined) along the plane's normal. */
+  double
+  residual(const Eigen::Vector3d& x) const
+  {
+    if (!planar_)
+      return 0.0;
+    const Eigen::Vector3d d = x - origin_ - plane_.centroid;
+    return d.dot(plane_.normal) - (curved_ ? basis(d).dot(coefficients_) : 0.0);
+  }
+
+  /** The unit normal of the plane of the points. */
+  const Eigen::Vector3d&
+  normal() const
+  {
+    return plane_.normal;
+  }
+
   /** Mean squared distance of the points to the jet (to the plane where the jet is
    * not determined). */
   double
@@ -202,6 +222,89 @@ private:
   bool planar_ = false, curved_ = false;
 };
 
+/** The K nearest of a vertex's nearest Delaunay neighbours and theirs (its
+ * two-ring), nearest first, ties by id; the vertices excluded are left out. */
+class TwoRing {
+public:
+  TwoRing(const std::vector<Eigen::Vector3d>& points,
+          const std::vector<std::array<int, NEAREST>>& nearest,
+          const std::vector<std::uint8_t>& excluded)
+  : points_(points), nearest_(nearest), excluded_(excluded), seen_(points.size(), -1)
+  {}
+
+  /** Write up to \a k neighbours of \a p to \a out; returns how many. */
+  int
+  gather(int p, int k, int* out)
+  {
+    int r = 0;
+    seen_[p] = p;
+    // A stamp per vertex drops the duplicates (a ring holds each neighbour several
+    // times) without a sort.
+    const auto offer = [&](int q) {
+      if (seen_[q] != p && (excluded_.empty() || !excluded_[q])) {
+        seen_[q] = p;
+        ring_[r++] = {(points_[q] - points_[p]).squaredNorm(), q};
+      }
+    };
+    for (const int q : nearest_[p]) {
+      if (q < 0)
+        break;
+      offer(q);
+      for (const int s : nearest_[q]) {
+        if (s < 0)
+          break;
+        offer(s);
+      }
+    }
+    const int size = std::min(r, k);
+    std::nth_element(ring_.begin(), ring_.begin() + size, ring_.begin() + r);
+    std::sort(ring_.begin(), ring_.begin() + size);
+    for (int i = 0; i < size; ++i)
+      out[i] = ring_[i].second;
+    return size;
+  }
+
+private:
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<std::array<int, NEAREST>>& nearest_;
+  const std::vector<std::uint8_t>& excluded_;
+  std::vector<int> seen_;
+  std::array<std::pair<double, int>, TWO_RING> ring_;
+};
+
+/** The number of p's nearest neighbours within three local spacings (the mean
+ * distance to the 6 nearest, written to \a spacing): the Delaunay neighbours of a
+ * surface sample include long edges across the inside or the outside, which are not
+ * the surface's. */
+int
+nearNeighbours(const std::vector<Eigen::Vector3d>& points,
+               const std::array<int, NEAREST>& list,
+               int p,
+               double* spacing)
+{
+  const int c = count(list);
+  double distance = 0.0;
+  for (int i = 0; i < std::min(c, SPACING_NEIGHBOURS); ++i)
+    distance += (points[list[i]] - points[p]).norm();
+  *spacing = c ? distance / std::min(c, SPACING_NEIGHBOURS) : 0.0;
+  const double reach2 = 9.0 * *spacing * *spacing;
+  int k = 0;
+  while (k < c && (points[list[k]] - points[p]).squaredNorm() <= reach2)
+    ++k;
+  return k;
+}
+
+/** The noise level of a point from the jet of it and its near neighbours: against
+ * the spread along the surface, which the noise does not inflate as it does the
+ * distances; off the jet rather than the plane, which would read a coarse sample's
+ * curvature as noise. */
+double
+noiseLevel(const Jet& jet)
+{
+  return jet.spread() > 0.0 ? LEVEL_SCALE * std::sqrt(jet.meanSquare() / jet.spread())
+                            : 0.0;
+}
+
 /** One round of analyzeNoise() over neighbour lists that leave out the outliers
  * found so far: the levels (in the first round) and the new outliers. */
 void
@@ -218,21 +321,12 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
   std::vector<std::uint8_t> near(n, 0), beside(n, 0);
   std::vector<float> spacing(n, 0.0f), offset(n, 0.0f);
   std::vector<std::uint8_t> found(n, 0);
+
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
   for (std::ptrdiff_t p = 0; p < n; ++p) {
-    const int c = count(lists[p]);
-    double distance = 0.0;
-    for (int i = 0; i < std::min(c, SPACING_NEIGHBOURS); ++i)
-      distance += (points[lists[p][i]] - points[p]).norm();
-    spacing[p] =
-        static_cast<float>(c ? distance / std::min(c, SPACING_NEIGHBOURS) : 0.0);
-    // Near: within three spacings. The Delaunay neighbours of a surface sample
-    // include long edges across the inside or the outside, which are not the
-    // surface's.
-    const double reach2 = 9.0 * double(spacing[p]) * spacing[p];
-    int k = 0;
-    while (k < c && (points[lists[p][k]] - points[p]).squaredNorm() <= reach2)
-      ++k;
+    double mean = 0.0;
+    const int k = nearNeighbours(points, lists[p], static_cast<int>(p), &mean);
+    spacing[p] = static_cast<float>(mean);
     near[p] = static_cast<std::uint8_t>(k);
     if (k < 3)
       continue;
@@ -249,26 +343,22 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
     beside[p] =
         (without.centroid - without.normal.dot(without.centroid) * without.normal)
             .norm() > normal_offset;
-    // The noise against the spread along the surface, which the noise does not
-    // inflate as it does the distances; off the jet rather than the plane, which
-    // would read a coarse sample's curvature as noise.
     if (!levels)
       continue;
-    const Jet jet(points, points[p], lists[p].data(), k, true);
-    if (jet.spread() > 0.0)
-      out.level[p] =
-          static_cast<float>(LEVEL_SCALE * std::sqrt(jet.meanSquare() / jet.spread()));
+    out.level[p] = static_cast<float>(
+        noiseLevel(Jet(points, points[p], lists[p].data(), k, true)));
   }
-  if (levels)
+  if (levels) {
     out.cloud_level = median(out.level);
+  }
 
-    // An outlier stands off the jet of its neighbours without it by half their
-    // spacing and by 6 sigma of the noise about that jet: neither the curvature,
-    // which the jet follows, nor p, which the jet leaves out, raises them. Only a
-    // point off the plane of its neighbours is a candidate (the jet is the expensive
-    // part), and only a point above them rather than beside them, which is how a point
-    // at a border sees its neighbours' fit, extrapolated, miss it; unless p is
-    // isolated, its spacing three times its neighbours'.
+  // An outlier stands off the jet of its neighbours without it by half their
+  // spacing and by 6 sigma of the noise about that jet: neither the curvature,
+  // which the jet follows, nor p, which the jet leaves out, raises them. Only a
+  // point off the plane of its neighbours is a candidate (the jet is the expensive
+  // part), and only a point above them rather than beside them, which is how a point
+  // at a border sees its neighbours' fit, extrapolated, miss it; unless p is
+  // isolated, its spacing three times its neighbours'.
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
   for (std::ptrdiff_t p = 0; p < n; ++p) {
     const int k = near[p];
@@ -323,6 +413,38 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
   return out;
 }
 
+double
+cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
+                const std::vector<std::array<int, NEAREST>>& nearest,
+                const std::vector<std::uint8_t>& outlier,
+                int threads)
+{
+  const auto samples = static_cast<std::ptrdiff_t>(
+      (points.size() + RECHECK_STRIDE - 1) / RECHECK_STRIDE);
+  std::vector<float> level(samples, std::numeric_limits<float>::quiet_NaN());
+#pragma omp parallel for num_threads(threads) schedule(static, 1024)
+  for (std::ptrdiff_t i = 0; i < samples; ++i) {
+    const int p = static_cast<int>(i * RECHECK_STRIDE);
+    if (!outlier.empty() && outlier[p])
+      continue;
+    std::array<int, NEAREST> list;
+    int c = 0;
+    for (const int q : nearest[p])
+      if (q >= 0 && (outlier.empty() || !outlier[q]))
+        list[c++] = q;
+    std::fill(list.begin() + c, list.end(), -1);
+    double spacing = 0.0;
+    const int k = nearNeighbours(points, list, p, &spacing);
+    if (k >= 3)
+      level[i] =
+          static_cast<float>(noiseLevel(Jet(points, points[p], list.data(), k, true)));
+  }
+  level.erase(
+      std::remove_if(level.begin(), level.end(), [](float l) { return std::isnan(l); }),
+      level.end());
+  return median(level);
+}
+
 std::vector<Eigen::Vector3d>
 smoothPoints(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, NEAREST>>& nearest,
@@ -338,37 +460,10 @@ smoothPoints(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> size(n, 0);
   detail::forEachRange(
       n, detail::partsFor(n, threads), [&](std::size_t begin, std::size_t end, int) {
-        // Per part: the last vertex whose ring each vertex joined (no sort to drop the
-        // duplicates of a ring, which holds each neighbour several times).
-        std::vector<int> seen(n, -1);
-        std::array<std::pair<double, int>, TWO_RING> ring;
-        for (std::size_t p = begin; p < end; ++p) {
-          if (is_outlier(static_cast<int>(p)))
-            continue;
-          int r = 0;
-          seen[p] = static_cast<int>(p);
-          const auto offer = [&](int q) {
-            if (seen[q] != static_cast<int>(p) && !is_outlier(q)) {
-              seen[q] = static_cast<int>(p);
-              ring[r++] = {(points[q] - points[p]).squaredNorm(), q};
-            }
-          };
-          for (const int q : nearest[p]) {
-            if (q < 0)
-              break;
-            offer(q);
-            for (const int s : nearest[q]) {
-              if (s < 0)
-                break;
-              offer(s);
-            }
-          }
-          size[p] = std::min(r, K);
-          std::nth_element(ring.begin(), ring.begin() + size[p], ring.begin() + r);
-          std::sort(ring.begin(), ring.begin() + size[p]);
-          for (int i = 0; i < size[p]; ++i)
-            neighbours[p * K + i] = ring[i].second;
-        }
+        TwoRing ring(points, nearest, outlier);
+        for (std::size_t p = begin; p < end; ++p)
+          if (!is_outlier(static_cast<int>(p)))
+            size[p] = ring.gather(static_cast<int>(p), K, &neighbours[p * K]);
       });
 
   std::vector<Eigen::Vector3d> current = points, next(points.size());

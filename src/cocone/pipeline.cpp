@@ -143,6 +143,11 @@ reconstruct(Triangulation& dt,
   }
 }
 
+/** The highest cloud noise level read as noise (about sigma in spacings). */
+constexpr double MAXIMUM_NOISE_LEVEL = 1.2;
+/** Smoothing took the noise out if it left at most this share of the noise level. */
+constexpr double SMOOTHED_NOISE_SHARE = 0.5;
+
 /** Noise handling between the first pass over the cells and the rest: the noise
  * levels, and where there are outliers or noise, the triangulation and the first pass
  * again, of the smoothed points without the outliers. Returns whether it replaced
@@ -163,16 +168,27 @@ handleNoise(Triangulation& dt,
   for (std::size_t i = 0; i < result.vertex_of_input.size(); ++i)
     if (result.vertex_of_input[i] >= 0)
       result.point_noise[i] = noise.level[result.vertex_of_input[i]];
-  result.smoothed = noise.cloud_level > parameters.noise_threshold;
+  std::vector<Eigen::Vector3d> kept;
+  // Above about a spacing the neighbourhoods are no surface patches the jets can
+  // follow: a surface too coarse or too creased for them, not noise.
+  if (noise.cloud_level > parameters.noise_threshold &&
+      noise.cloud_level <= MAXIMUM_NOISE_LEVEL) {
+    kept = smoothPoints(dt.points,
+                        cells.nearest,
+                        noise.outlier,
+                        std::max(parameters.smoothing_iterations, 1),
+                        threads);
+    // Smoothing takes noise out; what it leaves is a surface too coarse or creased
+    // for the jets, which smoothing would flatten: then the points stay as they are.
+    result.noise_after_smoothing =
+        cloudNoiseLevel(kept, cells.nearest, noise.outlier, threads);
+    result.smoothed =
+        result.noise_after_smoothing < SMOOTHED_NOISE_SHARE * noise.cloud_level;
+  }
   if (!result.smoothed && noise.outliers == 0)
     return false; // a clean cloud: the triangulation stands
-  std::vector<Eigen::Vector3d> kept =
-      result.smoothed ? smoothPoints(dt.points,
-                                     cells.nearest,
-                                     noise.outlier,
-                                     std::max(parameters.smoothing_iterations, 1),
-                                     threads)
-                      : std::move(dt.points);
+  if (!result.smoothed)
+    kept = std::move(dt.points);
   cells = VoronoiCells();
   dt.release();
   // The kept points, back in the caller's frame, renumbered by makeUniquePoints()

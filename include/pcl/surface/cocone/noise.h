@@ -63,6 +63,21 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
              int threads = 1);
 
+/** \brief The noise level of the cloud (NoiseAnalysis::cloud_level) read again on
+ * other positions of the same points, with the same neighbours, on one point in 4:
+ * after smoothing, whether it took the noise out. Noise goes, while a surface too
+ * coarse or too creased for the jets of a few neighbours reads as high as before.
+ * \param[in] points positions of the Delaunay vertices
+ * \param[in] nearest their nearest Delaunay neighbours (VoronoiCells::nearest)
+ * \param[in] outlier per vertex: an outlier, left out (empty: none)
+ * \param[in] threads threads to compute with (the result does not depend on them)
+ */
+double
+cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
+                const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
+                const std::vector<std::uint8_t>& outlier,
+                int threads = 1);
+
 /** \brief The points projected onto local fits (scale space): each point moves onto
  * the quadratic height field (a degree-2 jet, as CGAL's jet_smooth_point_set) fitted
  * by least squares to it and its neighbours, \a iterations times, the neighbourhoods
