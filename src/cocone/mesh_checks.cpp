@@ -66,6 +66,14 @@ EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented, int thread
   }
 }
 
+std::ptrdiff_t
+EdgeIncidences::find(int a, int b) const
+{
+  const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
+  const auto it = std::lower_bound(edges.begin(), edges.end(), key);
+  return it != edges.end() && *it == key ? it - edges.begin() : -1;
+}
+
 void
 EdgeIncidences::remove(const std::vector<std::uint8_t>& dropped)
 {

@@ -6,6 +6,7 @@
 #include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/candidates.h>
 #include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/noise.h>
 #include <pcl/surface/cocone/pipeline.h>
@@ -55,6 +56,7 @@ reconstruct(Triangulation& dt,
             const VoronoiCells& cells,
             const Parameters& parameters,
             const std::vector<double>& rim_reach,
+            const std::vector<double>& spacing,
             Result& result)
 {
   auto& counts = result.counts;
@@ -113,6 +115,18 @@ reconstruct(Triangulation& dt,
   // The borders, in vertex ids (neither the order of the triangles nor the corner
   // each starts at, both set below, matters to them).
   result.border_loops = boundaryLoops(incidences, dt.points.size());
+  if (parameters.fill_undersampled_holes && !spacing.empty()) {
+    const HoleFilling filled = fillUndersampledHoles(dt.points,
+                                                     spacing,
+                                                     result.triangles,
+                                                     incidences,
+                                                     result.border_loops,
+                                                     parameters.hole_reach,
+                                                     parameters.max_hole_edges);
+    counts.holes_filled = filled.holes;
+    counts.hole_triangles = filled.triangles;
+    result.filled_hole_sizes = filled.sizes;
+  }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
@@ -310,7 +324,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
 
   result.umbrella_failed.assign(result.vertices, 0);
   if (stages == Stages::RECONSTRUCTION) {
-    reconstruct(dt, cells, parameters, rim_reach, result);
+    reconstruct(dt, cells, parameters, rim_reach, spacing, result);
     result.timings.reconstruction = clock.lap();
   }
 

@@ -407,11 +407,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
       starts.push_back(b);
     }
   // Edge ab of the mesh as it was before the filling: its id, or -1.
-  const auto edge_id = [&](int a, int b) {
-    const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
-    const auto it = std::lower_bound(inc.edges.begin(), inc.edges.end(), key);
-    return it != inc.edges.end() && *it == key ? it - inc.edges.begin() : -1;
-  };
+  const auto edge_id = [&](int a, int b) { return inc.find(a, b); };
   // Whether the mesh had triangle abc: one of the triangles at ab has c.
   const auto had = [&](int a, int b, int c) {
     const auto e = edge_id(a, b);

@@ -49,6 +49,10 @@ struct EdgeIncidences {
     return !first.empty();
   }
 
+  /** The id of edge ab (either order), or -1 if there is none. */
+  std::ptrdiff_t
+  find(int a, int b) const;
+
   /** Number of triangles at edge e. */
   std::size_t
   count(std::size_t e) const

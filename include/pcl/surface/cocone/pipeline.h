@@ -43,6 +43,13 @@ struct Parameters {
   /** Close border loops of at most this many edges with Delaunay triangles: holes
    * below the sampling resolution (one or a few missing triangles); 0: none. */
   std::size_t fill_hole_edges = 6;
+  /** Close the border loops that are undersampled holes (fillUndersampledHoles()):
+   * the mesh is open only where the sampled surface ends. */
+  bool fill_undersampled_holes = true;
+  /** The longest edge of a hole's patch, in local spacings. */
+  double hole_reach = 2.0;
+  /** Border loops longer than this many edges stay open. */
+  std::size_t max_hole_edges = 1000;
   /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
    * cloud's noise level exceeds noise_threshold (and is at most 1.2: above, the
    * neighbourhoods are no surface patches) every decision is taken on a smoothed
@@ -74,6 +81,8 @@ struct ReconstructionCounts {
   std::size_t walk_conflicts = 0; ///< stage 7: triangles reached with both orientations
   std::size_t walk_reseeds = 0;   ///< stage 7: walks started after one per component
   RepairCounts repair;            ///< changes by the manifold repair
+  std::size_t holes_filled = 0;   ///< undersampled holes closed
+  std::size_t hole_triangles = 0; ///< triangles added to close them
 };
 
 /** \brief Wall-clock time of each stage, in milliseconds. */
@@ -133,6 +142,8 @@ struct Result {
   std::vector<Triangle> triangles;
   /** The mesh's triangles over caller ids. */
   std::vector<Triangle> polygons;
+  /** Edges of each undersampled hole closed. */
+  std::vector<std::size_t> filled_hole_sizes;
   /** Borders of the mesh as closed loops of caller ids. */
   std::vector<std::vector<int>> border_loops;
   /** Per vertex: unit pole direction turned to agree with the mesh (at undersampled
