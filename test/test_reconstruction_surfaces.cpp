@@ -5,6 +5,7 @@
  * Reconstruction (stages 1-7) on surfaces with known topology.
  */
 
+#include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
 #include <pcl/surface/cocone/repair.h>
@@ -665,4 +666,65 @@ TEST(Reconstruction, Deterministic)
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
   std::sort(original.begin(), original.end());
   EXPECT_EQ(mapped, original);
+}
+
+TEST(HoleFilling, ClosesHolesAsNarrowAsTheSpacingAndKeepsWiderOnes)
+{
+  using pcl::cocone::EdgeIncidences;
+  const cocone_test::Sample s = cocone_test::sphere(cocone_test::options(4000));
+  const auto r = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_TRUE(r.border_loops.empty());
+  const std::size_t n = r.positions.size();
+  // Per vertex the mean length of its edges, maximised over its neighbours (the
+  // local spacing's definition over the mesh's edges).
+  std::vector<double> length(n, 0.0), spacing(n, 0.0);
+  std::vector<int> degree(n, 0);
+  std::vector<std::vector<int>> ring(n);
+  for (const auto& t : r.triangles)
+    for (int i = 0; i < 3; ++i) {
+      const int a = t[i], b = t[(i + 1) % 3];
+      length[a] += (r.positions[a] - r.positions[b]).norm();
+      ++degree[a];
+      ring[a].push_back(b);
+    }
+  for (std::size_t v = 0; v < n; ++v) {
+    spacing[v] = length[v] / degree[v];
+    for (const int w : ring[v])
+      spacing[v] = std::max(spacing[v], length[w] / degree[w]);
+  }
+  // A hole cut around a vertex, its points left in place: 1.2 spacings in radius
+  // (narrower than two local spacings) is closed, 5 is not.
+  for (const double radius : {1.2, 5.0}) {
+    SCOPED_TRACE(radius);
+    const Eigen::Vector3d centre = r.positions[r.triangles[0][0]];
+    std::vector<pcl::cocone::Triangle> mesh;
+    for (const auto& t : r.triangles) {
+      const Eigen::Vector3d c =
+          (r.positions[t[0]] + r.positions[t[1]] + r.positions[t[2]]) / 3.0;
+      if ((c - centre).norm() > radius * s.spacing)
+        mesh.push_back(t);
+    }
+    EdgeIncidences inc(mesh);
+    auto loops = pcl::cocone::boundaryLoops(inc, n);
+    ASSERT_EQ(loops.size(), 1u);
+    const std::size_t cut = mesh.size();
+    const auto filled = pcl::cocone::fillUndersampledHoles(
+        r.positions, spacing, mesh, inc, loops, 2.0, 1000);
+    const auto topology = pcl::cocone::analyzeMesh(mesh, n);
+    EXPECT_TRUE(topology.manifold());
+    EXPECT_EQ(inc.edges, EdgeIncidences(mesh).edges);
+    if (radius < 2.0) {
+      EXPECT_EQ(filled.holes, 1u);
+      EXPECT_TRUE(loops.empty());
+      EXPECT_EQ(topology.boundary_edges, 0u);
+      EXPECT_EQ(topology.euler, 2);
+      EXPECT_EQ(mesh.size(), cut + filled.triangles);
+    }
+    else {
+      EXPECT_EQ(filled.holes, 0u);
+      EXPECT_EQ(loops.size(), 1u);
+      EXPECT_EQ(mesh.size(), cut);
+    }
+  }
 }
