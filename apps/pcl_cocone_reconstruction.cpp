@@ -40,8 +40,9 @@ struct Options {
   double normal_angle = M_PI / 6.0;
   double cocone_angle = 3.0 * M_PI / 8.0;
   bool boundary_detection = true;
+  bool noise_handling = true;
   int threads = 1;
-  std::string boundary_file, normals_file, report_file, screenshot_file;
+  std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
 };
 
 void
@@ -68,15 +69,22 @@ printHelp(const char* name)
       "  -theta T          normal angle in radians (default pi/6)\n"
       "  -cocone_angle A   co-cone angle in radians (default 3pi/8)\n"
       "  -no_boundary      plain Co-cone, no boundary detection\n"
+      "  -no_denoise       no noise handling: no outliers set aside, the points\n"
+      "                    used as given even when the cloud is noisy\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
+      "  -outliers FILE    write the outliers (in no triangle) as a .pcd with their\n"
+      "                    input index in the field 'index'\n"
       "  -normals FILE     write the cloud with oriented normals as a .pcd\n"
       "  -report FILE      write a JSON report\n"
       "  -screenshot FILE  render mesh and boundary to a .png without a window\n"
-      "  -v / -q           more / less output\n\n"
+      "  -v / -q           more / less output (-v: the noise level, whether the\n"
+      "                    points were smoothed, the outliers)\n\n"
       "The mesh keeps every field of the input cloud; unless the input has colours,\n"
-      "undersampled points are coloured red, so 'pcl_viewer OUTPUT.vtk' shows them.\n");
+      "undersampled points are coloured red, so 'pcl_viewer OUTPUT.vtk' shows them.\n"
+      "Outliers are set aside and noisy clouds are smoothed before the decisions\n"
+      "(the mesh keeps the input positions) unless -no_denoise is given.\n");
 }
 
 /** Outputs written so far: a failure removes them, so no run leaves half its files. */
@@ -118,10 +126,11 @@ parseOptions(int argc, char** argv)
                               "-cocone_angle",
                               "-threads",
                               "-boundary",
+                              "-outliers",
                               "-normals",
                               "-report",
                               "-screenshot"};
-  const char* switches[] = {"-no_boundary", "-v", "-q", "-h", "--help"};
+  const char* switches[] = {"-no_boundary", "-no_denoise", "-v", "-q", "-h", "--help"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     bool known = false;
@@ -164,7 +173,9 @@ parseOptions(int argc, char** argv)
     fail("-threads must be a whole number >= 0");
   o.threads = static_cast<int>(threads);
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
+  o.noise_handling = !find_switch(argc, argv, "-no_denoise");
   parse_argument(argc, argv, "-boundary", o.boundary_file);
+  parse_argument(argc, argv, "-outliers", o.outliers_file);
   parse_argument(argc, argv, "-normals", o.normals_file);
   parse_argument(argc, argv, "-report", o.report_file);
   parse_argument(argc, argv, "-screenshot", o.screenshot_file);
@@ -175,6 +186,8 @@ parseOptions(int argc, char** argv)
     fail("unknown output format '" + o.output + "' (use .vtk, .ply, .obj or .stl)");
   if (!o.boundary_file.empty() && cocone_app::extension(o.boundary_file) != "pcd")
     fail("-boundary must name a .pcd file");
+  if (!o.outliers_file.empty() && cocone_app::extension(o.outliers_file) != "pcd")
+    fail("-outliers must name a .pcd file");
   if (!o.normals_file.empty() && cocone_app::extension(o.normals_file) != "pcd")
     fail("-normals must name a .pcd file");
   if (!o.screenshot_file.empty() && cocone_app::extension(o.screenshot_file) != "png")
@@ -182,6 +195,7 @@ parseOptions(int argc, char** argv)
   std::string error;
   for (const auto* f : {&o.output,
                         &o.boundary_file,
+                        &o.outliers_file,
                         &o.normals_file,
                         &o.report_file,
                         &o.screenshot_file})
@@ -283,6 +297,7 @@ main(int argc, char** argv)
   cocone.setNormalAngle(o.normal_angle);
   cocone.setCoconeAngle(o.cocone_angle);
   cocone.setBoundaryDetection(o.boundary_detection);
+  cocone.setNoiseHandling(o.noise_handling);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
   pcl::PointCloud<pcl::PointXYZ> unused;
   std::vector<pcl::Vertices> polygons;
@@ -291,16 +306,27 @@ main(int argc, char** argv)
     fail("no reconstruction: the cloud has fewer than 4 distinct finite points or "
          "they are collinear");
   const auto& t = cocone.getTimings();
-  print_info("Delaunay %.0f ms, Voronoi %.0f ms, boundary %.0f ms (rho %.2f), "
-             "reconstruction %.0f ms.\n",
+  print_info("Delaunay %.0f ms, Voronoi %.0f ms, noise %.0f ms, boundary %.0f ms "
+             "(rho %.2f), reconstruction %.0f ms.\n",
              t.unique + t.delaunay,
              t.voronoi,
+             t.noise,
              t.boundary,
              cocone.getUsedRatio(),
              t.reconstruction);
 
   pcl::PointIndices boundary;
   cocone.getBoundaryPointIndices(boundary);
+  pcl::PointIndices outliers;
+  cocone.getOutlierIndices(outliers);
+  if (o.noise_handling)
+    print_debug("Noise level %.3f (about sigma in sample spacings), %s; %zu "
+                "outliers.\n",
+                cocone.getNoiseLevel(),
+                cocone.isSmoothed() ? "smoothed" : "not smoothed",
+                outliers.indices.size());
+  else
+    print_debug("Noise handling off (-no_denoise).\n");
   std::vector<pcl::Vertices> loops;
   cocone.getBoundaryLoops(loops);
 
@@ -352,6 +378,15 @@ main(int argc, char** argv)
       fail(error);
     written.push_back(o.boundary_file);
   }
+  if (!o.outliers_file.empty()) {
+    pcl::PCLPointCloud2 points;
+    pcl::copyPointCloud(blob, outliers.indices, points);
+    std::vector<std::uint32_t> index(outliers.indices.begin(), outliers.indices.end());
+    cocone_app::appendField(points, "index", pcl::PCLPointField::UINT32, index);
+    if (!cocone_app::writeCloud(o.outliers_file, points, error))
+      fail(error);
+    written.push_back(o.outliers_file);
+  }
   if (!o.normals_file.empty()) {
     pcl::PointCloud<pcl::Normal> normals;
     cocone.getPointNormals(normals);
@@ -388,13 +423,21 @@ main(int argc, char** argv)
       << ", \"gap_angle\": " << o.gap_angle << ", \"normal_angle\": " << o.normal_angle
       << ", \"cocone_angle\": " << o.cocone_angle
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
-      << ", \"threads\": " << o.threads << "},\n  \"triangles\": " << polygons.size()
+      << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
+      << ", \"threads\": " << o.threads
+      << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
+      << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
+      << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
+      << "},\n  \"outliers\": " << outliers.indices.size()
+      << ",\n  \"outlier_indices\": " << jsonList(outliers.indices)
+      << ",\n  \"triangles\": " << polygons.size()
       << ",\n  \"components\": " << components
       << ",\n  \"boundary_loops\": " << loops.size()
       << ",\n  \"boundary_indices\": " << jsonList(boundary.indices)
       << ",\n  \"border_indices\": " << jsonList(border) << ",\n  \"timings_ms\": {"
       << "\"load\": " << load_ms << ", \"delaunay\": " << t.unique + t.delaunay
-      << ", \"voronoi\": " << t.voronoi << ", \"boundary\": " << t.boundary
+      << ", \"voronoi\": " << t.voronoi << ", \"noise\": " << t.noise
+      << ", \"boundary\": " << t.boundary
       << ", \"reconstruction\": " << t.reconstruction << ", \"total\": " << total_ms
       << ", \"save\": " << save_ms << "}\n}\n";
     if (!cocone_app::writeText(o.report_file, r.str(), error))

@@ -33,11 +33,13 @@ struct Result {
   py::list border_loops;      ///< int32 arrays of input indices
   py::array normals;          ///< (N, 3) float64, NaN where not in the mesh
   py::array outlier_indices;  ///< int32, ascending
+  py::array point_noise;      ///< (N,) float32, NaN where unknown
   py::dict report;
 };
 
-const char* const PARAMETER_NAMES = "ratio, spacing_factor, gap_angle, normal_angle, "
-                                    "cocone_angle, boundary_detection, threads";
+const char* const PARAMETER_NAMES =
+    "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
+    "noise_handling, noise_threshold, smoothing_iterations, threads";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -64,6 +66,45 @@ requireValue(bool ok,
     throw py::value_error(std::string(function) + "(): " + name + " must be " + rule +
                           " (got " + py::repr(py::float_(value)).cast<std::string>() +
                           ")");
+}
+
+/** A bool parameter: bool or numpy.bool_ (an int would hide a mistaken argument). */
+bool
+toBool(const char* function, const std::string& name, const py::handle& value)
+{
+  const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
+  if (!PyBool_Check(value.ptr()) && !py::isinstance(value, numpy_bool))
+    throw py::type_error(std::string(function) + "(): parameter '" + name +
+                         "' must be a bool, not " +
+                         std::string(Py_TYPE(value.ptr())->tp_name));
+  return PyObject_IsTrue(value.ptr()) == 1;
+}
+
+/** An int parameter (not a bool) in [low, INT_MAX]; \a rule says what it must be. */
+int
+toInt(const char* function,
+      const std::string& name,
+      const py::handle& value,
+      long long low,
+      const char* rule)
+{
+  if (PyBool_Check(value.ptr()) || !PyIndex_Check(value.ptr()))
+    throw py::type_error(std::string(function) + "(): parameter '" + name +
+                         "' must be an int, not " +
+                         std::string(Py_TYPE(value.ptr())->tp_name));
+  const py::object index =
+      py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index)
+    throw py::error_already_set();
+  int overflow = 0;
+  long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0)
+    v = overflow < 0 ? std::numeric_limits<long long>::min()
+                     : std::numeric_limits<long long>::max();
+  if (v < low || v > std::numeric_limits<int>::max())
+    throw py::value_error(std::string(function) + "(): " + name + " must be " + rule +
+                          ", got " + py::repr(value).cast<std::string>());
+  return static_cast<int>(v);
 }
 
 /** The keyword arguments as cocone::Parameters, with the setters' rules
@@ -116,34 +157,23 @@ parseParameters(const char* function, const py::kwargs& kwargs)
                    "in (0, pi/2) radians",
                    p.cocone_angle);
     }
-    else if (name == "boundary_detection") {
-      // bool or numpy.bool_; an int would hide a mistaken argument.
-      const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
-      if (!PyBool_Check(value.ptr()) && !py::isinstance(value, numpy_bool))
-        throw py::type_error(std::string(function) +
-                             "(): parameter 'boundary_detection' must be a bool, not " +
-                             std::string(Py_TYPE(value.ptr())->tp_name));
-      p.boundary_detection = PyObject_IsTrue(value.ptr()) == 1;
+    else if (name == "boundary_detection")
+      p.boundary_detection = toBool(function, name, value);
+    else if (name == "noise_handling")
+      p.noise_handling = toBool(function, name, value);
+    else if (name == "noise_threshold") {
+      p.noise_threshold = toDouble(function, name, value);
+      requireValue(std::isfinite(p.noise_threshold) && p.noise_threshold >= 0.0,
+                   function,
+                   name,
+                   "finite and >= 0",
+                   p.noise_threshold);
     }
-    else if (name == "threads") {
-      if (PyBool_Check(value.ptr()) || !PyIndex_Check(value.ptr()))
-        throw py::type_error(std::string(function) +
-                             "(): parameter 'threads' must be an int, not " +
-                             std::string(Py_TYPE(value.ptr())->tp_name));
-      const py::object index =
-          py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-      if (!index)
-        throw py::error_already_set();
-      int overflow = 0;
-      long long threads = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-      if (overflow != 0)
-        threads = overflow < 0 ? -1 : std::numeric_limits<long long>::max();
-      if (threads < 0 || threads > std::numeric_limits<int>::max())
-        throw py::value_error(std::string(function) +
-                              "(): threads must be >= 0 (0: all processors), got " +
-                              py::repr(value).cast<std::string>());
-      p.threads = static_cast<unsigned int>(threads);
-    }
+    else if (name == "smoothing_iterations")
+      p.smoothing_iterations = toInt(function, name, value, 1, ">= 1");
+    else if (name == "threads")
+      p.threads = static_cast<unsigned int>(
+          toInt(function, name, value, 0, ">= 0 (0: all processors)"));
     else
       throw py::type_error(std::string(function) +
                            "() got an unexpected keyword argument '" + name +
@@ -248,6 +278,9 @@ parametersDict(const cocone::Parameters& p)
   d["normal_angle"] = p.normal_angle;
   d["cocone_angle"] = p.cocone_angle;
   d["boundary_detection"] = p.boundary_detection;
+  d["noise_handling"] = p.noise_handling;
+  d["noise_threshold"] = p.noise_threshold;
+  d["smoothing_iterations"] = p.smoothing_iterations;
   d["threads"] = p.threads;
   return d;
 }
@@ -318,6 +351,11 @@ runPipeline(const char* function,
   std::vector<int> outliers = takeOutliers(r);
   const std::size_t outlier_count = outliers.size();
   out.outlier_indices = indexArray(std::move(outliers));
+  // The noise level per input point; the core leaves it empty without noise handling
+  // (and where it could not read it): NaN then.
+  if (r.point_noise.size() != n)
+    r.point_noise.assign(n, std::numeric_limits<float>::quiet_NaN());
+  out.point_noise = ownedArray(std::move(r.point_noise), {static_cast<py::ssize_t>(n)});
 
   const cocone::Timings& t = r.timings;
   py::dict timings;
@@ -325,6 +363,7 @@ runPipeline(const char* function,
   timings["unique"] = t.unique;
   timings["delaunay"] = t.delaunay;
   timings["voronoi"] = t.voronoi;
+  timings["noise"] = t.noise;
   timings["boundary"] = t.boundary;
   timings["reconstruction"] = t.reconstruction;
   timings["run"] = run_ms; // all of cocone::run()
@@ -357,6 +396,9 @@ runPipeline(const char* function,
   report["boundary_points"] = boundary_count;
   report["border_loops"] = loop_count;
   report["outliers"] = outlier_count;
+  report["noise_level"] = r.noise_level; // about sigma in sample spacings
+  report["noise_after_smoothing"] = r.noise_after_smoothing;
+  report["smoothed"] = r.smoothed;
   report["ratio"] = r.ratio; // the one used: the automatic one when ratio is 0
   report["parameters"] = parametersDict(parameters);
   report["timings_ms"] = timings;
@@ -391,6 +433,20 @@ PYBIND11_MODULE(_pcl_cocone, m)
                     &Result::outlier_indices,
                     "int32, ascending: the input indices of the points set aside as "
                     "outliers.")
+      .def_readonly("point_noise",
+                    &Result::point_noise,
+                    "(N,) float32: the noise level of each input point (about sigma "
+                    "in sample spacings), NaN where the point is not finite or "
+                    "without noise handling.")
+      .def_property_readonly(
+          "noise_level",
+          [](const Result& r) { return r.report["noise_level"]; },
+          "float: the noise level of the cloud, the median of point_noise (about "
+          "sigma in sample spacings; 0 without noise handling).")
+      .def_property_readonly(
+          "smoothed",
+          [](const Result& r) { return r.report["smoothed"]; },
+          "bool: the decisions were taken on smoothed points (a noisy cloud).")
       .def_readonly("report",
                     &Result::report,
                     "dict: counts, the ratio used, the parameters and per-stage "
@@ -415,7 +471,8 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "Reconstruct the well-sampled surface of (N, 3) points (float64 or float32, "
       "read in place) and find the undersampled ones. Parameters: ratio, "
       "spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
-      "threads. Runs without the GIL.");
+      "noise_handling (outliers set aside, noisy clouds smoothed; default True), "
+      "noise_threshold, smoothing_iterations, threads. Runs without the GIL.");
   m.def(
       "detect_boundary",
       [](const py::object& points, const py::kwargs& kwargs) {

@@ -10,9 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include <support/cases.h>
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -384,4 +386,133 @@ TEST(CoConeBoundary, MeshIndicesReferToTheInputCloud)
                 : 1.0f;
     EXPECT_GT(outward, 0.9f) << i;
   }
+}
+
+TEST(CoConeBoundary, NoiseAndOutliers)
+{
+  // A noisy hemisphere (sigma half a spacing, random samples) and 5 points 10 radii
+  // away.
+  const auto s = cocone_test::hemisphere(cocone_test::options(6000, 0.5, 1, false));
+  auto cloud = toCloud<pcl::PointXYZ>(s.points);
+  cloud->header.frame_id = "scan";
+  const int n = static_cast<int>(s.points.size());
+  for (const auto& p : {pcl::PointXYZ(10, 0, 0.5f),
+                        pcl::PointXYZ(-10, 0, 0.5f),
+                        pcl::PointXYZ(0, 10, 0.5f),
+                        pcl::PointXYZ(0, -10, 0.5f),
+                        pcl::PointXYZ(0, 0, 10)})
+    cloud->push_back(p);
+  const std::vector<int> far = {n, n + 1, n + 2, n + 3, n + 4};
+
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  EXPECT_TRUE(cocone.getNoiseHandling());
+  cocone.setInputCloud(cloud);
+  pcl::PolygonMesh mesh;
+  cocone.reconstruct(mesh);
+  ASSERT_GT(mesh.polygons.size(), 5000u);
+
+  pcl::PointIndices outliers;
+  cocone.getOutlierIndices(outliers);
+  EXPECT_EQ(outliers.header.frame_id, "scan");
+  EXPECT_TRUE(std::is_sorted(outliers.indices.begin(), outliers.indices.end()));
+  for (const int i : far)
+    EXPECT_TRUE(std::binary_search(outliers.indices.begin(), outliers.indices.end(), i))
+        << i;
+  // Outliers are in no triangle.
+  std::vector<bool> is_outlier(cloud->size(), false);
+  for (const int i : outliers.indices)
+    is_outlier[i] = true;
+  for (const auto& p : mesh.polygons)
+    for (const auto v : p.vertices)
+      ASSERT_FALSE(is_outlier[v]) << v;
+
+  EXPECT_TRUE(cocone.isSmoothed());
+  EXPECT_GE(cocone.getNoiseLevel(), 0.35);
+  EXPECT_LE(cocone.getNoiseLevel(), 0.7);
+  EXPECT_LT(cocone.getNoiseLevelAfterSmoothing(), 0.5 * cocone.getNoiseLevel());
+
+  // A level per input point (all are finite and used).
+  std::vector<float> levels;
+  cocone.getPointNoiseLevels(levels);
+  ASSERT_EQ(levels.size(), cloud->size());
+  for (std::size_t i = 0; i < levels.size(); ++i)
+    EXPECT_TRUE(std::isfinite(levels[i])) << i;
+
+  // The smoothed cloud: finite where used, NaN at the outliers, near the input and
+  // nearer the true surface than the noisy points.
+  pcl::PointCloud<pcl::PointXYZ> smoothed;
+  cocone.getSmoothedCloud(smoothed);
+  ASSERT_EQ(smoothed.size(), cloud->size());
+  EXPECT_EQ(smoothed.header.frame_id, "scan");
+  double input_error = 0.0, smoothed_error = 0.0;
+  for (int i = 0; i < static_cast<int>(cloud->size()); ++i) {
+    if (is_outlier[i]) {
+      EXPECT_FALSE(pcl::isFinite(smoothed[i])) << i;
+      continue;
+    }
+    ASSERT_TRUE(pcl::isFinite(smoothed[i])) << i;
+    EXPECT_LT((smoothed[i].getVector3fMap() - (*cloud)[i].getVector3fMap()).norm(),
+              3.0 * s.spacing)
+        << i;
+    input_error += s.distance((*cloud)[i].getVector3fMap().cast<double>());
+    smoothed_error += s.distance(smoothed[i].getVector3fMap().cast<double>());
+  }
+  EXPECT_LT(smoothed_error, 0.5 * input_error);
+
+  // Normals: NaN at the outliers.
+  pcl::PointCloud<pcl::Normal> normals;
+  cocone.getPointNormals(normals);
+  for (const int i : far)
+    EXPECT_FALSE(std::isfinite(normals[i].normal_x)) << i;
+
+  // setIndices on a subset (every other hemisphere point and the far ones): the
+  // outliers are still indices into the input cloud, among those selected.
+  pcl::IndicesPtr indices(new pcl::Indices);
+  for (int i = 0; i < n; i += 2)
+    indices->push_back(i);
+  indices->insert(indices->end(), far.begin(), far.end());
+  std::vector<bool> selected(cloud->size(), false);
+  for (const int i : *indices)
+    selected[i] = true;
+  cocone.setIndices(indices);
+  cocone.reconstruct(mesh);
+  ASSERT_GT(mesh.polygons.size(), 2000u);
+  cocone.getOutlierIndices(outliers);
+  for (const int i : far)
+    EXPECT_TRUE(std::binary_search(outliers.indices.begin(), outliers.indices.end(), i))
+        << i;
+  for (const int i : outliers.indices)
+    EXPECT_TRUE(selected[i]) << i;
+  cocone.getPointNoiseLevels(levels);
+  cocone.getSmoothedCloud(smoothed);
+  ASSERT_EQ(levels.size(), cloud->size());
+  ASSERT_EQ(smoothed.size(), cloud->size());
+  is_outlier.assign(cloud->size(), false);
+  for (const int i : outliers.indices)
+    is_outlier[i] = true;
+  for (int i = 0; i < n; ++i) {
+    EXPECT_EQ(std::isfinite(levels[i]), selected[i]) << i;
+    EXPECT_EQ(pcl::isFinite(smoothed[i]), selected[i] && !is_outlier[i]) << i;
+  }
+
+  // Without noise handling: no outliers, no smoothing, no levels; the smoothed cloud
+  // is the input.
+  pcl::CoConeBoundary<pcl::PointXYZ> plain;
+  plain.setNoiseHandling(false);
+  EXPECT_FALSE(plain.getNoiseHandling());
+  plain.setInputCloud(cloud);
+  plain.reconstruct(mesh);
+  ASSERT_GT(mesh.polygons.size(), 5000u);
+  plain.getOutlierIndices(outliers);
+  EXPECT_TRUE(outliers.indices.empty());
+  EXPECT_FALSE(plain.isSmoothed());
+  EXPECT_EQ(plain.getNoiseLevel(), 0.0);
+  plain.getPointNoiseLevels(levels);
+  ASSERT_EQ(levels.size(), cloud->size());
+  EXPECT_TRUE(std::none_of(
+      levels.begin(), levels.end(), [](float l) { return std::isfinite(l); }));
+  plain.getSmoothedCloud(smoothed);
+  ASSERT_EQ(smoothed.size(), cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    EXPECT_EQ(smoothed[i].getVector3fMap(), (*cloud)[i].getVector3fMap()) << i;
 }

@@ -435,3 +435,131 @@ TEST_F(Tool, ScreenshotIsNotBlank)
   // A blank 1024 x 768 frame compresses to a few kilobytes; a rendered mesh does not.
   EXPECT_GT(bytes.size(), 20000u);
 }
+
+namespace {
+
+/** A PCD of the sample's points followed by \a extra points. */
+void
+savePoints(const std::string& path,
+           const std::vector<Eigen::Vector3d>& points,
+           const std::vector<Eigen::Vector3d>& extra = {})
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const auto* set : {&points, &extra})
+    for (const auto& p : *set)
+      cloud.push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  pcl::io::savePCDFileBinary(path, cloud);
+}
+
+std::string
+slurpText(const std::string& path)
+{
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+} // namespace
+
+TEST_F(Tool, OutliersFileAndReport)
+{
+  // A sphere of radius 1 with three points 10 radii away: those are the outliers.
+  cocone_test::SampleOptions o;
+  o.n = 3000;
+  const cocone_test::Sample s = cocone_test::sphere(o);
+  const std::vector<Eigen::Vector3d> far = {
+      {10.0, 0.0, 0.0}, {0.0, -10.0, 0.0}, {0.0, 0.0, 10.0}};
+  savePoints(dir_ + "/far.pcd", s.points, far);
+  const int n = static_cast<int>(s.points.size());
+  const std::string report = dir_ + "/far.json";
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/far.pcd " + dir_ + "/far.ply -v -report " + report +
+                    " -outliers " + dir_ + "/far_o.pcd",
+                &log),
+            0)
+      << log;
+  // -v tells the noise level, the smoothing and the outliers.
+  EXPECT_NE(log.find("Noise level"), std::string::npos) << log;
+  EXPECT_NE(log.find("3 outliers"), std::string::npos) << log;
+
+  // The outliers file: exactly the far points, with their input indices and
+  // coordinates.
+  pcl::PCLPointCloud2 blob;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/far_o.pcd", blob), 0);
+  ASSERT_EQ(std::size_t(blob.width) * blob.height, far.size());
+  const int index = pcl::getFieldIndex(blob, "index");
+  ASSERT_GE(index, 0);
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(blob, points);
+  for (std::size_t j = 0; j < far.size(); ++j) {
+    std::uint32_t i;
+    std::memcpy(&i, &blob.data[j * blob.point_step + blob.fields[index].offset], 4);
+    EXPECT_EQ(i, std::uint32_t(n + j));
+    EXPECT_EQ(points[j].getVector3fMap(), far[j].cast<float>());
+  }
+  // No triangle uses them.
+  pcl::PolygonMesh mesh;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/far.ply", mesh), 0);
+  ASSERT_GT(mesh.polygons.size(), 5000u);
+  for (const auto& p : mesh.polygons)
+    for (const auto v : p.vertices)
+      ASSERT_LT(int(v), n);
+
+  const std::string json = slurpText(report);
+  for (const char* key : {"\"noise\": {\"level\": ",
+                          "\"after_smoothing\": ",
+                          "\"smoothed\": false",
+                          "\"noise_handling\": true",
+                          "\"noise\": "})
+    EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+  EXPECT_NE(json.find("\"outliers\": 3,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"outlier_indices\": [" + std::to_string(n) + "," +
+                      std::to_string(n + 1) + "," + std::to_string(n + 2) + "]"),
+            std::string::npos)
+      << json;
+  // The noise timing is among the stages.
+  const std::size_t timings = json.find("\"timings_ms\"");
+  ASSERT_NE(timings, std::string::npos);
+  EXPECT_NE(json.find("\"noise\": ", timings), std::string::npos) << json;
+
+  // Bad file names fail before any work.
+  EXPECT_NE(
+      run(dir_ + "/far.pcd " + dir_ + "/far2.ply -outliers " + dir_ + "/o.txt", &log),
+      0);
+  EXPECT_NE(log.find("-outliers must name a .pcd file"), std::string::npos) << log;
+  EXPECT_FALSE(exists(dir_ + "/far2.ply"));
+}
+
+TEST_F(Tool, NoDenoiseKeepsTheNoisyPoints)
+{
+  cocone_test::SampleOptions o;
+  o.n = 5000;
+  o.noise = 0.5;
+  o.even = false;
+  savePoints(dir_ + "/noisy.pcd", cocone_test::hemisphere(o).points);
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/noisy.pcd " + dir_ + "/noisy.ply -q -report " + dir_ +
+                    "/noisy.json -outliers " + dir_ + "/noisy_o.pcd",
+                &log),
+            0)
+      << log;
+  const std::string smoothed = slurpText(dir_ + "/noisy.json");
+  EXPECT_NE(smoothed.find("\"smoothed\": true"), std::string::npos) << smoothed;
+  EXPECT_NE(smoothed.find("\"noise_handling\": true"), std::string::npos);
+
+  ASSERT_EQ(run(dir_ + "/noisy.pcd " + dir_ + "/raw.ply -q -no_denoise -report " +
+                    dir_ + "/raw.json -outliers " + dir_ + "/raw_o.pcd",
+                &log),
+            0)
+      << log;
+  const std::string raw = slurpText(dir_ + "/raw.json");
+  EXPECT_NE(raw.find("\"smoothed\": false"), std::string::npos) << raw;
+  EXPECT_NE(raw.find("\"noise_handling\": false"), std::string::npos) << raw;
+  EXPECT_NE(raw.find("\"outliers\": 0,"), std::string::npos) << raw;
+  EXPECT_NE(raw.find("\"outlier_indices\": []"), std::string::npos) << raw;
+  // Without noise handling the outliers file is written, empty.
+  pcl::PCLPointCloud2 blob;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/raw_o.pcd", blob), 0);
+  EXPECT_EQ(std::size_t(blob.width) * blob.height, 0u);
+}

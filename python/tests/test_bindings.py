@@ -185,7 +185,8 @@ def test_bad_points():
     ("ratio", -1.0), ("ratio", float("inf")), ("ratio", float("nan")),
     ("spacing_factor", -0.5), ("gap_angle", math.pi), ("gap_angle", -0.1),
     ("normal_angle", 0.0), ("normal_angle", 2.0), ("cocone_angle", math.pi / 2),
-    ("cocone_angle", 0.0), ("threads", -1)])
+    ("cocone_angle", 0.0), ("threads", -1), ("noise_threshold", -0.1),
+    ("noise_threshold", float("inf")), ("smoothing_iterations", 0)])
 def test_bad_parameter_value(name, value):
     with pytest.raises(ValueError, match=name):
         pcl_cocone.reconstruct(sphere(100), **{name: value})
@@ -202,13 +203,20 @@ def test_bad_parameter_name_or_type():
         pcl_cocone.reconstruct(sphere(100), boundary_detection=1)
     with pytest.raises(TypeError, match="must be an int"):
         pcl_cocone.reconstruct(sphere(100), threads=1.5)
+    with pytest.raises(TypeError, match="must be a bool"):
+        pcl_cocone.reconstruct(sphere(100), noise_handling=1)
+    with pytest.raises(TypeError, match="must be an int"):
+        pcl_cocone.reconstruct(sphere(100), smoothing_iterations=2.0)
 
 
 def test_parameters_are_used():
     points = sphere(4000, cap=0.8)
     defaults = pcl_cocone.default_parameters()
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
-                             "cocone_angle", "boundary_detection", "threads"}
+                             "cocone_angle", "boundary_detection", "noise_handling",
+                             "noise_threshold", "smoothing_iterations", "threads"}
+    assert defaults["noise_handling"] is True
+    assert defaults["smoothing_iterations"] >= 1
     plain = pcl_cocone.reconstruct(points, boundary_detection=False)
     assert len(plain.boundary_indices) <= len(
         pcl_cocone.reconstruct(points).boundary_indices)
@@ -216,6 +224,54 @@ def test_parameters_are_used():
     same = pcl_cocone.reconstruct(points, threads=np.int64(0), ratio=np.float32(0.0),
                                   boundary_detection=np.bool_(True), gap_angle=1)
     assert same.report["parameters"]["gap_angle"] == 1.0
+
+
+def test_outliers_far_from_a_sphere():
+    points = sphere(3000)
+    far = np.array([[10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, 10.0]])
+    points = np.vstack((points[:1000], far, points[1000:]))  # at 1000, 1001, 1002
+    n = len(points)
+    result = pcl_cocone.reconstruct(points)
+    check_mesh(result, n)
+    outliers = result.outlier_indices
+    assert outliers.dtype == np.int32
+    assert np.all(np.diff(outliers) > 0)  # ascending
+    assert set(outliers) >= {1000, 1001, 1002}
+    assert result.report["outliers"] == len(outliers)
+    # The outliers are in no triangle and have no normal.
+    assert not np.isin(result.triangles, outliers).any()
+    assert np.all(np.isnan(result.normals[outliers]))
+    # A clean sphere: not smoothed, a low level, one per point.
+    assert result.smoothed is False and result.report["smoothed"] is False
+    assert 0.0 <= result.noise_level < 0.1
+    assert result.noise_level == result.report["noise_level"]
+    assert result.point_noise.shape == (n,) and result.point_noise.dtype == np.float32
+    assert np.all(np.isfinite(result.point_noise))
+    assert result.report["timings_ms"]["noise"] >= 0.0
+    assert result.report["parameters"]["noise_handling"] is True
+
+    # Without noise handling: no outliers, no levels.
+    plain = pcl_cocone.reconstruct(points, noise_handling=False)
+    assert len(plain.outlier_indices) == 0
+    assert plain.noise_level == 0.0 and plain.smoothed is False
+    assert np.all(np.isnan(plain.point_noise))
+    assert plain.report["parameters"]["noise_handling"] is False
+
+
+def test_noisy_sphere_is_smoothed():
+    rng = np.random.default_rng(3)
+    points = random_sphere(5000, seed=4)
+    spacing = math.sqrt(4.0 * math.pi / len(points))
+    points *= 1.0 + rng.normal(0.0, 0.5 * spacing, (len(points), 1))
+    result = pcl_cocone.reconstruct(points, smoothing_iterations=2,
+                                    noise_threshold=0.1)
+    assert result.smoothed is True
+    assert result.noise_level > 0.1
+    assert result.report["noise_after_smoothing"] < 0.5 * result.noise_level
+    assert result.report["parameters"]["smoothing_iterations"] == 2
+    # A threshold above the cloud's level: left as it is.
+    high = pcl_cocone.reconstruct(points, noise_threshold=2.0)
+    assert high.smoothed is False and high.report["noise_after_smoothing"] == 0.0
 
 
 def test_gil_is_released():

@@ -51,9 +51,20 @@ namespace pcl {
  * cocone.getBoundaryPointIndices (boundary);
  * \endcode
  *
+ * Noise and outliers (see setNoiseHandling(), on by default): the points that lie
+ * off the surface their neighbours sample are set aside as outliers
+ * (getOutlierIndices()) and are in no triangle; when the cloud is noisy
+ * (getNoiseLevel(), about the noise sigma in sample spacings) every decision is
+ * taken on a smoothed copy of the points (isSmoothed(), getSmoothedCloud()), while
+ * the mesh still indexes the input cloud. A clean cloud without outliers gives the
+ * same result as without noise handling.
+ *
  * Non-finite points are skipped and exact duplicates share one Delaunay vertex;
  * every index this class returns refers to the input cloud, also with setIndices().
- * The mesh's cloud is the whole input cloud with all its fields.
+ * The mesh's cloud is the whole input cloud with all its fields. Every input index
+ * is either in the mesh, an outlier, non-finite, or undersampled or otherwise left
+ * out of the mesh (or not among the indices set); duplicates share their vertex,
+ * its triangles and its labels.
  *
  * \ingroup surface
  */
@@ -209,6 +220,82 @@ public:
   {
     return parameters_.threads;
   }
+
+  /** \brief Enable or disable the noise handling.
+   *
+   * Outliers, points off the surface their neighbours sample (flying pixels, points
+   * far from everything), are set aside: in no triangle, reported by
+   * getOutlierIndices(). When the cloud's noise level (getNoiseLevel()) exceeds 0.1
+   * (and is at most 1.2: above, the neighbourhoods are no surface patches) every
+   * decision is taken on a copy of the points projected twice onto local degree-2
+   * jets, provided this took the noise out (isSmoothed()); the mesh still indexes
+   * the input points. A clean cloud without outliers keeps its result.
+   * \param[in] enabled false: the points as given, no outliers (default true)
+   */
+  void
+  setNoiseHandling(bool enabled)
+  {
+    parameters_.noise_handling = enabled;
+  }
+
+  /** \brief Whether the noise handling is enabled. */
+  bool
+  getNoiseHandling() const
+  {
+    return parameters_.noise_handling;
+  }
+
+  /** \brief The noise level of the cloud in the last run: the median over the points
+   * of getPointNoiseLevels(), about the sigma of Gaussian noise in units of the
+   * sample spacing (clean samples read below 0.05); 0 without noise handling. */
+  double
+  getNoiseLevel() const
+  {
+    return result_.noise_level;
+  }
+
+  /** \brief The noise level of the cloud in the last run read again on the smoothed
+   * points (same neighbours): smoothing is kept when it leaves at most half of
+   * getNoiseLevel() (isSmoothed()); 0 if smoothing was not tried (the cloud's level
+   * at most 0.1 or above 1.2, or no noise handling). */
+  double
+  getNoiseLevelAfterSmoothing() const
+  {
+    return result_.noise_after_smoothing;
+  }
+
+  /** \brief The noise level of every point in the last run: the RMS distance of the
+   * point and its nearest neighbours to their least-squares degree-2 jet over their
+   * spread along it (about sigma in spacings, as getNoiseLevel()).
+   * \param[out] levels one per input cloud point; NaN where the point was not used
+   *             (not finite, not among the indices, or no noise handling)
+   */
+  void
+  getPointNoiseLevels(std::vector<float>& levels) const;
+
+  /** \brief The outliers of the last run: the points set aside by the noise handling,
+   * in no triangle, as indices into the input cloud, ascending (every duplicate of
+   * an outlier is listed).
+   * \param[out] outliers the indices; empty without noise handling
+   */
+  void
+  getOutlierIndices(pcl::PointIndices& outliers) const;
+
+  /** \brief Whether the decisions of the last run were taken on smoothed points (the
+   * cloud was noisy, see setNoiseHandling()). */
+  bool
+  isSmoothed() const
+  {
+    return result_.smoothed;
+  }
+
+  /** \brief The positions the last run took its decisions on.
+   * \param[out] cloud one point per input cloud point: its smoothed position, or its
+   *             input position if the cloud was not smoothed; NaN for the points not
+   *             used (not finite, not among the indices) and for the outliers
+   */
+  void
+  getSmoothedCloud(pcl::PointCloud<pcl::PointXYZ>& cloud) const;
 
   /** \brief Number of distinct finite points (Delaunay vertices) of the last run. */
   std::size_t

@@ -133,8 +133,9 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
     return false;
   }
   PCL_DEBUG("[pcl::%s::%s] %zu points, %zu unique; timings (ms): unique %.1f, "
-            "Delaunay %.1f, Voronoi %.1f, boundary %.1f, reconstruction %.1f; "
-            "rho %.3f; %zu boundary points, %zu triangles.\n",
+            "Delaunay %.1f, Voronoi %.1f, noise %.1f, boundary %.1f, reconstruction "
+            "%.1f; rho %.3f; noise level %.3f%s, %zu outliers; %zu boundary points, "
+            "%zu triangles.\n",
             getClassName().c_str(),
             caller,
             count,
@@ -142,9 +143,13 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
             timings_.unique,
             timings_.delaunay,
             timings_.voronoi,
+            timings_.noise,
             timings_.boundary,
             timings_.reconstruction,
             result_.ratio,
+            result_.noise_level,
+            result_.smoothed ? " (smoothed)" : "",
+            result_.outlier_indices.size(),
             result_.boundary_indices.size(),
             result_.triangles.size());
   return true;
@@ -181,6 +186,63 @@ CoConeBoundary<PointInT>::getBoundaryPointIndices(pcl::PointIndices& boundary) c
 
 template <typename PointInT>
 void
+CoConeBoundary<PointInT>::getOutlierIndices(pcl::PointIndices& outliers) const
+{
+  if (input_)
+    outliers.header = input_->header;
+  outliers.indices = pcl::Indices(result_.outlier_indices);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::getPointNoiseLevels(std::vector<float>& levels) const
+{
+  levels.assign(cloud_size_, std::numeric_limits<float>::quiet_NaN());
+  // point_noise is indexed like the points passed to the core (ids_); empty without
+  // noise handling.
+  if (result_.point_noise.size() != ids_.size())
+    return;
+  for (std::size_t i = 0; i < ids_.size(); ++i)
+    levels[ids_[i]] = result_.point_noise[i];
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::getSmoothedCloud(pcl::PointCloud<pcl::PointXYZ>& cloud) const
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cloud.clear();
+  cloud.resize(cloud_size_, pcl::PointXYZ(nan, nan, nan));
+  cloud.is_dense = false;
+  if (input_) {
+    cloud.header = input_->header;
+    if (input_->size() == cloud_size_ && input_->height > 1) {
+      cloud.width = input_->width;
+      cloud.height = input_->height;
+    }
+  }
+  if (result_.vertex_of_input.size() != ids_.size())
+    return;
+  const bool from_input = !result_.smoothed && input_ && input_->size() == cloud_size_;
+  for (std::size_t i = 0; i < ids_.size(); ++i) {
+    const int v = result_.vertex_of_input[i];
+    // v < 0: not finite (-1) or an outlier (-2).
+    if (v < 0 || static_cast<std::size_t>(v) >= result_.positions.size())
+      continue;
+    if (from_input) { // the input position, exactly
+      const PointInT& p = (*input_)[ids_[i]];
+      cloud[ids_[i]] = pcl::PointXYZ(p.x, p.y, p.z);
+      continue;
+    }
+    const Eigen::Vector3d q = result_.positions[v] + result_.offset;
+    cloud[ids_[i]] = pcl::PointXYZ(static_cast<float>(q.x()),
+                                   static_cast<float>(q.y()),
+                                   static_cast<float>(q.z()));
+  }
+}
+
+template <typename PointInT>
+void
 CoConeBoundary<PointInT>::getBoundaryLoops(std::vector<pcl::Vertices>& loops) const
 {
   loops.clear();
@@ -205,7 +267,9 @@ CoConeBoundary<PointInT>::getPointNormals(pcl::PointCloud<pcl::Normal>& normals)
     return;
   for (std::size_t i = 0; i < ids_.size(); ++i) {
     const int v = result_.vertex_of_input[i];
-    if (v < 0 || !std::isfinite(result_.normals[v].x()))
+    // v < 0: not finite (-1) or an outlier (-2), in no triangle.
+    if (v < 0 || static_cast<std::size_t>(v) >= result_.normals.size() ||
+        !std::isfinite(result_.normals[v].x()))
       continue;
     const Eigen::Vector3d& n = result_.normals[v];
     normals[ids_[i]] = pcl::Normal(static_cast<float>(n.x()),
