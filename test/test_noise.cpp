@@ -1,0 +1,347 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * Noise handling of the pipeline (noise.h): the noise level read off the cloud,
+ * smoothing of noisy clouds, outliers set aside, and clean clouds left as they are.
+ */
+
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/pipeline.h>
+
+#include <gtest/gtest.h>
+
+#include <support/cases.h>
+#include <support/metrics.h>
+#include <support/surfaces.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
+using cocone_test::options;
+using cocone_test::Sample;
+using cocone_test::SampleOptions;
+using pcl::cocone::Parameters;
+using pcl::cocone::Result;
+
+namespace {
+
+Result
+reconstruct(const std::vector<Eigen::Vector3d>& points,
+            const Parameters& parameters = Parameters())
+{
+  Result r = pcl::cocone::run(points, parameters, pcl::cocone::Stages::RECONSTRUCTION);
+  EXPECT_TRUE(r.error.empty()) << r.error;
+  return r;
+}
+
+/** 99th percentile of the distances of the mesh's triangle centroids, over the
+ * positions the pipeline decided on (the smoothed ones when smoothed), from the true
+ * surface, in sample spacings. */
+double
+centroidDistance99(const Sample& s, const Result& r)
+{
+  std::vector<double> d;
+  d.reserve(r.triangles.size());
+  for (const auto& t : r.triangles) {
+    const Eigen::Vector3d c =
+        (r.positions[t[0]] + r.positions[t[1]] + r.positions[t[2]]) / 3.0 + r.offset;
+    d.push_back(s.distance(c) / s.spacing);
+  }
+  if (d.empty())
+    return INFINITY;
+  const std::size_t k = (d.size() - 1) * 99 / 100;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+  return d[k];
+}
+
+/** Whether caller id \a i is used by a triangle of \a r. */
+bool
+inMesh(const Result& r, int i)
+{
+  for (const auto& t : r.polygons)
+    if (std::find(t.begin(), t.end(), i) != t.end())
+      return true;
+  return false;
+}
+
+/** The outliers reported are set aside: no vertex, in no triangle. */
+void
+expectSetAside(const Result& r)
+{
+  EXPECT_TRUE(std::is_sorted(r.outlier_indices.begin(), r.outlier_indices.end()));
+  std::vector<std::uint8_t> used(r.vertex_of_input.size(), 0);
+  for (const auto& t : r.polygons)
+    for (const int i : t)
+      used[std::size_t(i)] = 1;
+  for (const int i : r.outlier_indices) {
+    EXPECT_EQ(r.vertex_of_input[std::size_t(i)], -2) << i;
+    EXPECT_FALSE(used[std::size_t(i)]) << i;
+  }
+}
+
+bool
+reported(const Result& r, int i)
+{
+  return std::binary_search(r.outlier_indices.begin(), r.outlier_indices.end(), i);
+}
+
+/** A closed manifold mesh of the given Euler characteristic. */
+void
+expectClosed(const Sample& s, const Result& r, long euler)
+{
+  const auto score = cocone_test::scoreMesh(s, r);
+  std::printf("[ measured ] %-22s %s; noise %.3f, outliers %zu\n",
+              s.name.c_str(),
+              score.str().c_str(),
+              r.noise_level,
+              r.outlier_indices.size());
+  EXPECT_TRUE(score.topology.manifold()) << score.str();
+  EXPECT_EQ(r.border_loops.size(), 0u);
+  EXPECT_EQ(score.topology.boundary_edges, 0u);
+  EXPECT_EQ(score.topology.euler, euler);
+  EXPECT_EQ(score.topology.components, 1u);
+  expectSetAside(r);
+}
+
+using Generator = std::function<Sample(const SampleOptions&)>;
+
+struct Surface {
+  const char* name;
+  Generator make;
+};
+
+const Surface HEMISPHERE{
+    "hemisphere", [](const SampleOptions& o) { return cocone_test::hemisphere(o); }};
+const Surface SADDLE{"monkey_saddle", [](const SampleOptions& o) {
+                       return cocone_test::monkeySaddle(o);
+                     }};
+const Surface TORUS{"torus",
+                    [](const SampleOptions& o) { return cocone_test::torus(o); }};
+const Surface SPHERE{"sphere",
+                     [](const SampleOptions& o) { return cocone_test::sphere(o); }};
+
+const Surface NOISY_SURFACES[] = {
+    HEMISPHERE,
+    SADDLE,
+    {"open_cylinder",
+     [](const SampleOptions& o) { return cocone_test::openCylinder(o); }},
+    {"holes_30deg",
+     [](const SampleOptions& o) {
+       return cocone_test::sphereWithHoles(o, 3, M_PI / 6.0);
+     }},
+    {"holes_15deg",
+     [](const SampleOptions& o) {
+       return cocone_test::sphereWithHoles(o, 3, M_PI / 12.0);
+     }},
+    TORUS,
+    {"genus2", [](const SampleOptions& o) { return cocone_test::genus2(o); }},
+};
+
+struct NoisyCase {
+  Surface surface;
+  double sigma;
+};
+
+void
+PrintTo(const NoisyCase& c, std::ostream* os)
+{
+  *os << c.surface.name << " sigma " << c.sigma;
+}
+
+std::vector<NoisyCase>
+noisyCases()
+{
+  std::vector<NoisyCase> cases;
+  for (const auto& s : NOISY_SURFACES)
+    for (const double sigma : {0.3, 0.5, 1.0})
+      cases.push_back({s, sigma});
+  return cases;
+}
+
+class NoisySurface : public ::testing::TestWithParam<NoisyCase> {};
+
+} // namespace
+
+TEST_P(NoisySurface, TopologyOfTheTrueSurface)
+{
+  // Gaussian noise along the normal of sigma spacings on 10,000 random samples.
+  const double sigma = GetParam().sigma;
+  const Sample s = GetParam().surface.make(options(10000, sigma, 1.0, false));
+  const Result r = reconstruct(s.points);
+  const auto score = cocone_test::scoreMesh(s, r);
+  const double distance = centroidDistance99(s, r);
+  std::printf("[ measured ] %-14s sigma %.1f: noise %.3f -> %.3f, loops %zu (true %d), "
+              "euler %ld (true %d), components %zu, centroid distance p99 %.3f\n",
+              GetParam().surface.name,
+              sigma,
+              r.noise_level,
+              r.noise_after_smoothing,
+              r.border_loops.size(),
+              s.boundary_loops,
+              score.topology.euler,
+              s.euler,
+              score.topology.components,
+              distance);
+  EXPECT_TRUE(score.topology.manifold()) << score.str();
+  // The level reads about sigma (a little low at 1: the jets take some noise for
+  // shape), and the smoothing took the noise out.
+  EXPECT_NEAR(r.noise_level, sigma, 0.2 * sigma);
+  EXPECT_TRUE(r.smoothed);
+  EXPECT_LE(r.noise_after_smoothing, 0.5 * r.noise_level);
+  EXPECT_EQ(r.border_loops.size(), std::size_t(s.boundary_loops));
+  EXPECT_EQ(score.topology.euler, s.euler);
+  EXPECT_EQ(score.topology.components, 1u);
+  // The mesh over the smoothed points lies on the true surface.
+  EXPECT_LT(distance, 1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Noise, NoisySurface, ::testing::ValuesIn(noisyCases()), [](const auto& info) {
+      const int tenths = int(info.param.sigma * 10.0 + 0.5);
+      return std::string(info.param.surface.name) + "_sigma_" +
+             std::to_string(tenths / 10) + "_" + std::to_string(tenths % 10);
+    });
+
+TEST(Noise, CleanCloudUnchanged)
+{
+  // Clean samples read no noise and have no outlier: the pipeline gives what it
+  // gives without noise handling, bit for bit.
+  Parameters off;
+  off.noise_handling = false;
+  for (const Surface& surface : {HEMISPHERE, SADDLE, TORUS, SPHERE})
+    for (const bool even : {false, true}) {
+      const Sample s = surface.make(options(10000, 0.0, 1.0, even));
+      SCOPED_TRACE(s.name + (even ? " even" : " random"));
+      const Result r = reconstruct(s.points);
+      std::printf("[ measured ] %-14s %s: noise %.4f, smoothed %d, outliers %zu\n",
+                  s.name.c_str(),
+                  even ? "even  " : "random",
+                  r.noise_level,
+                  int(r.smoothed),
+                  r.outlier_indices.size());
+      EXPECT_LT(r.noise_level, 0.05);
+      EXPECT_GT(r.noise_level, 0.0); // it was measured
+      EXPECT_FALSE(r.smoothed);
+      EXPECT_TRUE(r.outlier_indices.empty());
+      const Result plain = reconstruct(s.points, off);
+      EXPECT_EQ(plain.noise_level, 0.0);
+      EXPECT_EQ(r.triangles, plain.triangles);
+      EXPECT_EQ(r.polygons, plain.polygons);
+      EXPECT_EQ(r.border_loops, plain.border_loops);
+    }
+}
+
+TEST(Noise, FarPointIsAnOutlier)
+{
+  // A point 10 radii away (before outlier detection: a hole torn open).
+  Sample s = cocone_test::sphere(options(5000, 0.0, 1.0, false));
+  const int far = static_cast<int>(s.points.size());
+  s.points.emplace_back(10.0, 0.0, 0.0);
+  const Result r = reconstruct(s.points);
+  expectClosed(s, r, 2);
+  EXPECT_TRUE(reported(r, far));
+  EXPECT_EQ(r.vertex_of_input[far], -2);
+  EXPECT_FALSE(inMesh(r, far));
+}
+
+TEST(Noise, PointsAroundTheSphereAreOutliers)
+{
+  // 20 points within 3 radii of the centre, none within 0.1 of the sphere.
+  Sample s = cocone_test::sphere(options(5000, 0.0, 1.0, false));
+  const int first = static_cast<int>(s.points.size());
+  std::mt19937_64 rng(11);
+  const auto uniform = [&] {
+    return double(rng() >> 11) / 9007199254740992.0 * 6.0 - 3.0;
+  };
+  while (s.points.size() < std::size_t(first) + 20) {
+    const Eigen::Vector3d p(uniform(), uniform(), uniform());
+    if (p.norm() < 3.0 && std::abs(p.norm() - 1.0) >= 0.1)
+      s.points.push_back(p);
+  }
+  const Result r = reconstruct(s.points);
+  expectClosed(s, r, 2);
+  int found = 0;
+  for (int i = first; i < first + 20; ++i)
+    found += reported(r, i);
+  std::printf("[ measured ] %d of 20 reported\n", found);
+  EXPECT_GE(found, 18);
+}
+
+TEST(Noise, FlyingPixels)
+{
+  // 1 % of a torus' points moved 1 to 3 spacings along the normal.
+  const Sample s = cocone_test::withOutliers(
+      cocone_test::torus(options(10000, 0.0, 1.0, false)), 0.01, 3.0, 5);
+  const Result r = reconstruct(s.points);
+  expectClosed(s, r, 0);
+  std::size_t outliers = 0, found = 0, false_outliers = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    outliers += s.outlier[i];
+    found += s.outlier[i] && reported(r, int(i));
+  }
+  for (const int i : r.outlier_indices)
+    false_outliers += !s.outlier[std::size_t(i)];
+  std::printf("[ measured ] flying pixels: %zu of %zu found, %zu false\n",
+              found,
+              outliers,
+              false_outliers);
+  ASSERT_GT(outliers, 0u);
+  EXPECT_GE(double(found), 0.9 * double(outliers));
+  EXPECT_EQ(false_outliers, 0u);
+}
+
+TEST(Noise, ScatteredOutliers)
+{
+  // 1 % of a sphere's count added uniformly in its bounding box.
+  const Sample s = cocone_test::withScatteredOutliers(
+      cocone_test::sphere(options(10000, 0.0, 1.0, false)), 0.01, 5);
+  const Result r = reconstruct(s.points);
+  expectClosed(s, r, 2);
+  // Those near the surface by chance are samples of it, as good as any.
+  std::size_t off = 0, found = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (s.outlier[i] && s.distance(s.points[i]) > s.spacing) {
+      ++off;
+      found += reported(r, int(i));
+    }
+  std::printf("[ measured ] scattered outliers: %zu of %zu found\n", found, off);
+  ASSERT_GT(off, 0u);
+  EXPECT_GE(double(found), 0.85 * double(off));
+}
+
+TEST(Noise, RangeViews)
+{
+  // Six registered scans, half a spacing of registration error, noise 0.3.
+  for (const auto& c : {std::make_pair(SPHERE, 2L), std::make_pair(TORUS, 0L)}) {
+    const Sample s =
+        cocone_test::rangeViews(c.first.make(options(30000)), 6, 0.5, 7, 0.3);
+    SCOPED_TRACE(s.name);
+    ASSERT_TRUE(s.closed);
+    ASSERT_EQ(s.euler, c.second);
+    const Result r = reconstruct(s.points);
+    expectClosed(s, r, c.second);
+  }
+}
+
+TEST(Noise, SameOutputOnAnyThreads)
+{
+  const Sample s = cocone_test::hemisphere(options(10000, 0.5, 1.0, false));
+  Parameters one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const Result a = reconstruct(s.points, one);
+  const Result b = reconstruct(s.points, two);
+  ASSERT_TRUE(a.smoothed);
+  EXPECT_EQ(a.noise_level, b.noise_level);
+  EXPECT_EQ(a.outlier_indices, b.outlier_indices);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.border_loops, b.border_loops);
+}
