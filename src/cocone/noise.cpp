@@ -26,6 +26,9 @@ constexpr std::size_t TWO_RING = std::size_t(NEAREST) * (NEAREST + 1);
 constexpr int SPACING_NEIGHBOURS = 6;
 /** Neighbourhood of the smoothing: CGAL's default for jet fitting. */
 constexpr int SMOOTHING_NEIGHBOURS = 24;
+/** Points a jet is fitted to at least: twice its six coefficients, or the fit
+ * follows the noise. */
+constexpr int JET_POINTS = 12;
 /** Turns sqrt(mean square off the plane / spread along it) over a point and its
  * nearest Delaunay neighbours into sigma in spacings: measured on random samples
  * with Gaussian noise of 0.3, 0.5 and 1 spacing. */
@@ -95,7 +98,8 @@ public:
       const Eigen::Vector3d& origin,
       const int* neighbours,
       int k,
-      bool with_origin)
+      bool with_origin,
+      int min_points = JET_POINTS)
   : origin_(origin)
   {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -115,8 +119,7 @@ public:
     mean_square_ = plane_.mean_square;
     if (points > 3)
       sigma_ = std::sqrt(mean_square_ * points / (points - 3));
-    // Twice the jet's six coefficients at least, or the fit follows the noise.
-    if (points < 12)
+    if (points < min_points)
       return;
     scale_ = 1.0 / std::sqrt(radius2);
     Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
@@ -170,6 +173,13 @@ public:
       return 0.0;
     const Eigen::Vector3d d = x - origin_ - plane_.centroid;
     return d.dot(plane_.normal) - (curved_ ? basis(d).dot(coefficients_) : 0.0);
+  }
+
+  /** Whether the jet is determined (else it is the plane). */
+  bool
+  curved() const
+  {
+    return curved_;
   }
 
   /** The unit normal of the plane of the points. */
@@ -340,9 +350,12 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
     const Plane without = fitPlane(sum, outer, k);
     const double normal_offset = std::abs(without.normal.dot(without.centroid));
     offset[p] = static_cast<float>(normal_offset);
-    beside[p] =
+    // Beside its neighbours rather than above them: p's foot on their plane is off
+    // their centroid by more than its height, or by more than half their spread.
+    const double foot =
         (without.centroid - without.normal.dot(without.centroid) * without.normal)
-            .norm() > normal_offset;
+            .norm();
+    beside[p] = foot > normal_offset || foot > 0.8 * std::sqrt(without.spread);
     if (!levels)
       continue;
     out.level[p] = static_cast<float>(
@@ -369,10 +382,15 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
       around[i] = spacing[lists[p][i]];
     std::nth_element(around.begin(), around.begin() + k / 2, around.begin() + k);
     const double around_spacing = around[k / 2];
-    if (!(offset[p] > 0.25 * around_spacing) ||
-        (beside[p] && !(spacing[p] > 3.0 * around_spacing)))
+    const bool isolated = spacing[p] > 3.0 * around_spacing;
+    if (!(offset[p] > 0.25 * around_spacing) || (beside[p] && !isolated))
       continue;
-    const Jet jet(points, points[p], lists[p].data(), k, false);
+    // A jet of 9 neighbours at least (a flying pixel has fewer near ones than a
+    // surface point): a plane of a few misses a curved surface's point by as much
+    // as a pixel, so only an isolated point is judged by one.
+    const Jet jet(points, points[p], lists[p].data(), k, false, 9);
+    if (!jet.curved() && !isolated)
+      continue;
     const double off = (jet.project(points[p]) - points[p]).norm();
     found[p] = off > 0.25 * around_spacing && off > 6.0 * jet.sigma();
   }
