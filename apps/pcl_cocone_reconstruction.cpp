@@ -41,6 +41,7 @@ struct Options {
   double cocone_angle = 3.0 * M_PI / 8.0;
   bool boundary_detection = true;
   bool noise_handling = true;
+  bool fill_holes = true;
   int threads = 1;
   std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
 };
@@ -71,6 +72,8 @@ printHelp(const char* name)
       "  -no_boundary      plain Co-cone, no boundary detection\n"
       "  -no_denoise       no noise handling: no outliers set aside, the points\n"
       "                    used as given even when the cloud is noisy\n"
+      "  -no_fill          leave the undersampled holes open (by default a border\n"
+      "                    loop that triangles of the local spacing close is closed)\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
@@ -130,7 +133,8 @@ parseOptions(int argc, char** argv)
                               "-normals",
                               "-report",
                               "-screenshot"};
-  const char* switches[] = {"-no_boundary", "-no_denoise", "-v", "-q", "-h", "--help"};
+  const char* switches[] = {
+      "-no_boundary", "-no_denoise", "-no_fill", "-v", "-q", "-h", "--help"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     bool known = false;
@@ -174,6 +178,7 @@ parseOptions(int argc, char** argv)
   o.threads = static_cast<int>(threads);
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
   o.noise_handling = !find_switch(argc, argv, "-no_denoise");
+  o.fill_holes = !find_switch(argc, argv, "-no_fill");
   parse_argument(argc, argv, "-boundary", o.boundary_file);
   parse_argument(argc, argv, "-outliers", o.outliers_file);
   parse_argument(argc, argv, "-normals", o.normals_file);
@@ -298,6 +303,7 @@ main(int argc, char** argv)
   cocone.setCoconeAngle(o.cocone_angle);
   cocone.setBoundaryDetection(o.boundary_detection);
   cocone.setNoiseHandling(o.noise_handling);
+  cocone.setFillUndersampledHoles(o.fill_holes);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
   pcl::PointCloud<pcl::PointXYZ> unused;
   std::vector<pcl::Vertices> polygons;
@@ -424,12 +430,15 @@ main(int argc, char** argv)
       << ", \"cocone_angle\": " << o.cocone_angle
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
       << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
+      << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
       << ", \"threads\": " << o.threads
       << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
       << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
       << "},\n  \"outliers\": " << outliers.indices.size()
       << ",\n  \"outlier_indices\": " << jsonList(outliers.indices)
+      << ",\n  \"holes_filled\": " << cocone.getReconstructionCounts().holes_filled
+      << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
       << ",\n  \"triangles\": " << polygons.size()
       << ",\n  \"components\": " << components
       << ",\n  \"boundary_loops\": " << loops.size()

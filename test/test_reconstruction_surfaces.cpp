@@ -728,3 +728,35 @@ TEST(HoleFilling, ClosesHolesAsNarrowAsTheSpacingAndKeepsWiderOnes)
     }
   }
 }
+
+TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)
+{
+  // Coarse random samples: a cube of 800 points (sharp edges and corners) and the
+  // genus-2 surface of 1,500 leave undersampled holes that the step closes.
+  struct Case {
+    cocone_test::Sample sample;
+    long euler;
+  };
+  for (const auto& c :
+       {Case{cocone_test::cube(cocone_test::options(800, 0, 1, false)), 2},
+        Case{cocone_test::genus2(cocone_test::options(1500, 0, 1, false)), -2}}) {
+    SCOPED_TRACE(c.sample.name);
+    pcl::cocone::Parameters off;
+    off.fill_undersampled_holes = false;
+    const auto open =
+        pcl::cocone::run(c.sample.points, off, pcl::cocone::Stages::RECONSTRUCTION);
+    const auto r = pcl::cocone::run(c.sample.points,
+                                    pcl::cocone::Parameters(),
+                                    pcl::cocone::Stages::RECONSTRUCTION);
+    EXPECT_GT(open.border_loops.size(), 0u);
+    EXPECT_EQ(r.counts.holes_filled, open.border_loops.size());
+    EXPECT_EQ(r.filled_hole_sizes.size(), r.counts.holes_filled);
+    const auto m = cocone_test::scoreMesh(c.sample, r);
+    EXPECT_TRUE(m.topology.manifold()) << m.str();
+    EXPECT_EQ(m.loops, 0u);
+    EXPECT_EQ(m.topology.boundary_edges, 0u);
+    EXPECT_EQ(m.topology.components, 1u);
+    EXPECT_EQ(m.topology.euler, c.euler);
+    EXPECT_GT(m.volume, 0.0); // facing outward
+  }
+}

@@ -238,6 +238,32 @@ public:
     parameters_.noise_handling = enabled;
   }
 
+  /** \brief Close the border loops that are undersampled holes, keep the true
+   * borders open (the question the paper leaves open).
+   *
+   * After the reconstruction every border loop of up to 1,000 edges is closed when
+   * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces finds a
+   * patch whose new edges are all at most 2 local spacings long: an undersampled
+   * hole has samples all around it that continue the surface at that spacing,
+   * where the sampled surface really ends nothing is that close across. No new
+   * vertex; the mesh stays an oriented manifold. getBoundaryPointIndices() is not
+   * changed by it (the paper's output); getBoundaryLoops() lists the loops left.
+   * \param[in] enabled false: the holes left open, the mesh as without the step
+   *            (default true)
+   */
+  void
+  setFillUndersampledHoles(bool enabled)
+  {
+    parameters_.fill_undersampled_holes = enabled;
+  }
+
+  /** \brief Whether undersampled holes are closed. */
+  bool
+  getFillUndersampledHoles() const
+  {
+    return parameters_.fill_undersampled_holes;
+  }
+
   /** \brief Whether the noise handling is enabled. */
   bool
   getNoiseHandling() const
