@@ -39,7 +39,8 @@ struct Result {
 
 const char* const PARAMETER_NAMES =
     "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
-    "noise_handling, noise_threshold, smoothing_iterations, threads";
+    "noise_handling, noise_threshold, smoothing_iterations, fill_undersampled_holes, "
+    "threads";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -161,6 +162,8 @@ parseParameters(const char* function, const py::kwargs& kwargs)
       p.boundary_detection = toBool(function, name, value);
     else if (name == "noise_handling")
       p.noise_handling = toBool(function, name, value);
+    else if (name == "fill_undersampled_holes")
+      p.fill_undersampled_holes = toBool(function, name, value);
     else if (name == "noise_threshold") {
       p.noise_threshold = toDouble(function, name, value);
       requireValue(std::isfinite(p.noise_threshold) && p.noise_threshold >= 0.0,
@@ -279,6 +282,7 @@ parametersDict(const cocone::Parameters& p)
   d["cocone_angle"] = p.cocone_angle;
   d["boundary_detection"] = p.boundary_detection;
   d["noise_handling"] = p.noise_handling;
+  d["fill_undersampled_holes"] = p.fill_undersampled_holes;
   d["noise_threshold"] = p.noise_threshold;
   d["smoothing_iterations"] = p.smoothing_iterations;
   d["threads"] = p.threads;
@@ -385,6 +389,8 @@ runPipeline(const char* function,
   counts["walk_conflicts"] = c.walk_conflicts;
   counts["walk_reseeds"] = c.walk_reseeds;
   counts["repair"] = repair;
+  counts["holes_filled"] = c.holes_filled;
+  counts["hole_triangles"] = c.hole_triangles;
 
   py::dict& report = out.report;
   report["stages"] = stages == cocone::Stages::RECONSTRUCTION ? "reconstruction"
@@ -472,7 +478,9 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "read in place) and find the undersampled ones. Parameters: ratio, "
       "spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
       "noise_handling (outliers set aside, noisy clouds smoothed; default True), "
-      "noise_threshold, smoothing_iterations, threads. Runs without the GIL.");
+      "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
+      "that triangles of the local spacing close are closed; default True), threads. "
+      "Runs without the GIL.");
   m.def(
       "detect_boundary",
       [](const py::object& points, const py::kwargs& kwargs) {

@@ -214,8 +214,10 @@ def test_parameters_are_used():
     defaults = pcl_cocone.default_parameters()
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
                              "cocone_angle", "boundary_detection", "noise_handling",
-                             "noise_threshold", "smoothing_iterations", "threads"}
+                             "noise_threshold", "smoothing_iterations",
+                             "fill_undersampled_holes", "threads"}
     assert defaults["noise_handling"] is True
+    assert defaults["fill_undersampled_holes"] is True
     assert defaults["smoothing_iterations"] >= 1
     plain = pcl_cocone.reconstruct(points, boundary_detection=False)
     assert len(plain.boundary_indices) <= len(
