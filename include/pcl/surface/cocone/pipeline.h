@@ -109,8 +109,8 @@ struct Result {
   /** The noise level of the cloud (NoiseAnalysis::cloud_level; 0 without noise
    * handling). */
   double noise_level = 0.0;
-  /** The noise level after smoothing (cloudNoiseLevel()); 0 if the cloud was not
-   * smoothed. */
+  /** The noise level after smoothing (cloudNoiseLevel()), also when the smoothing
+   * was then not kept; 0 if it was not tried. */
   double noise_after_smoothing = 0.0;
   /** Per point passed to run(): its noise level (NoiseAnalysis::level), NaN if it
    * is not finite; empty without noise handling. */
