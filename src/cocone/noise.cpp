@@ -351,7 +351,8 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
     const double normal_offset = std::abs(without.normal.dot(without.centroid));
     offset[p] = static_cast<float>(normal_offset);
     // Beside its neighbours rather than above them: p's foot on their plane is off
-    // their centroid by more than its height, or by more than half their spread.
+    // their centroid by more than its height, or by more than 0.8 of their RMS
+    // spread.
     const double foot =
         (without.centroid - without.normal.dot(without.centroid) * without.normal)
             .norm();
@@ -365,7 +366,7 @@ noiseRound(const std::vector<Eigen::Vector3d>& points,
     out.cloud_level = median(out.level);
   }
 
-  // An outlier stands off the jet of its neighbours without it by half their
+  // An outlier stands off the jet of its neighbours without it by a quarter of their
   // spacing and by 6 sigma of the noise about that jet: neither the curvature,
   // which the jet follows, nor p, which the jet leaves out, raises them. Only a
   // point off the plane of its neighbours is a candidate (the jet is the expensive
