@@ -426,6 +426,10 @@ private:
   bool
   compute(cocone::Stages stages, const char* caller);
 
+  /** Input indices of the last run as PCL indices, with the input's header. */
+  void
+  toPointIndices(const std::vector<int>& ids, pcl::PointIndices& out) const;
+
   /** Append the mesh's triangles. */
   void
   fillPolygons(std::vector<pcl::Vertices>& polygons) const;

@@ -179,18 +179,24 @@ template <typename PointInT>
 void
 CoConeBoundary<PointInT>::getBoundaryPointIndices(pcl::PointIndices& boundary) const
 {
-  if (input_)
-    boundary.header = input_->header;
-  boundary.indices = pcl::Indices(result_.boundary_indices);
+  toPointIndices(result_.boundary_indices, boundary);
 }
 
 template <typename PointInT>
 void
 CoConeBoundary<PointInT>::getOutlierIndices(pcl::PointIndices& outliers) const
 {
+  toPointIndices(result_.outlier_indices, outliers);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::toPointIndices(const std::vector<int>& ids,
+                                         pcl::PointIndices& out) const
+{
   if (input_)
-    outliers.header = input_->header;
-  outliers.indices = pcl::Indices(result_.outlier_indices);
+    out.header = input_->header;
+  out.indices = pcl::Indices(ids);
 }
 
 template <typename PointInT>
