@@ -82,8 +82,8 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
  * the quadratic height field (a degree-2 jet, as CGAL's jet_smooth_point_set) fitted
  * by least squares to it and its neighbours, \a iterations times, the neighbourhoods
  * found once. The neighbours are the K nearest among p's nearest Delaunay neighbours
- * and theirs (a two-ring, K = 24 as CGAL's default neighbourhood); outliers neither
- * move nor count as anyone's neighbour.
+ * and their 10 nearest (a two-ring, K = 24 as CGAL's default neighbourhood); outliers
+ * neither move nor count as anyone's neighbour.
  *
  * Written here rather than called from CGAL: jet_smooth_point_set takes 41 s on a
  * million points (its k-d tree search 11 s, its Monge fit by SVD most of the rest),
