@@ -16,6 +16,8 @@
 #include <pcl/PCLPointField.h>
 #include <pcl/point_types.h>
 
+#include <Eigen/Geometry>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -344,6 +346,79 @@ readText(const std::string& path,
   return true;
 }
 
+/** The scans a Stanford range-scan configuration lists ("bmesh FILE tx ty tz qx qy
+ * qz qw" lines, the files relative to the configuration's directory), each moved
+ * into the common frame and merged. A listed scan that is missing is left out with
+ * a warning (the repositories ship subsets); none found is an error. */
+bool
+readScanConfiguration(const std::string& path,
+                      pcl::PCLPointCloud2& cloud,
+                      std::string& error)
+{
+  std::ifstream in(path);
+  const std::string directory = directoryOf(path);
+  pcl::PointCloud<pcl::PointXYZ> merged;
+  std::vector<std::string> missing;
+  std::size_t listed = 0, number = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    ++number;
+    std::istringstream fields(line);
+    std::string tag, file;
+    if (!(fields >> tag) || tag != "bmesh")
+      continue; // the camera, comments
+    double t[3], q[4];
+    if (!(fields >> file >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) {
+      error = "line " + std::to_string(number) +
+              " is not 'bmesh FILE tx ty tz qx qy qz qw'";
+      return false;
+    }
+    ++listed;
+    const std::string scan = file.front() == '/' ? file : directory + "/" + file;
+    if (!isFile(scan)) {
+      missing.push_back(file);
+      continue;
+    }
+    pcl::PCLPointCloud2 blob;
+    std::vector<Eigen::Vector3d> xyz;
+    if (!readCloud(scan, blob, error) || !extractXYZ(blob, xyz, error)) {
+      error = file + ": " + error;
+      return false;
+    }
+    // The stored rotation takes the common frame to the scan's: a point moves by
+    // its inverse (the conjugate quaternion), then the translation. Measured on the
+    // Stanford bunny: so the overlapping scans agree within half a sample spacing;
+    // the rotation itself leaves them several spacings apart.
+    const Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
+    const Eigen::Matrix3d R = rotation.normalized().conjugate().toRotationMatrix();
+    const Eigen::Vector3d translation(t[0], t[1], t[2]);
+    for (const auto& x : xyz) {
+      const Eigen::Vector3d y = R * x + translation;
+      merged.push_back(pcl::PointXYZ(static_cast<float>(y.x()),
+                                     static_cast<float>(y.y()),
+                                     static_cast<float>(y.z())));
+    }
+  }
+  if (listed == missing.size()) {
+    error = listed == 0 ? "no 'bmesh' line" : "none of the scans it lists is there";
+    return false;
+  }
+  if (!missing.empty()) {
+    std::string names;
+    for (const auto& name : missing)
+      names += " " + name;
+    pcl::console::print_warn("%s: %zu of the %zu scans listed are missing, merged the "
+                             "others (missing:%s)\n",
+                             path.c_str(),
+                             missing.size(),
+                             listed,
+                             names.c_str());
+  }
+  merged.is_dense = false;
+  pcl::toPCLPointCloud2(merged, cloud);
+  return true;
+}
+
 } // namespace
 
 std::string
@@ -364,7 +439,7 @@ bool
 isInputFormat(const std::string& ext)
 {
   return ext == "pcd" || ext == "ply" || ext == "obj" || ext == "xyz" || ext == "txt" ||
-         ext == "pts";
+         ext == "pts" || ext == "conf";
 }
 
 bool
@@ -378,11 +453,18 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
 {
   const std::string ext = extension(path);
   if (!isInputFormat(ext)) {
-    error = "unknown input format '" + ext + "' (use .pcd, .ply, .obj, .xyz, .txt)";
+    error =
+        "unknown input format '" + ext + "' (use .pcd, .ply, .obj, .xyz, .txt, .conf)";
     return false;
   }
   if (!isFile(path)) {
     error = "cannot read '" + path + "' (missing, unreadable or empty)";
+    return false;
+  }
+  if (ext == "conf") {
+    if (readScanConfiguration(path, cloud, error))
+      return true;
+    error = "cannot read '" + path + "': " + error;
     return false;
   }
   // PCL's readers print their own complaints; the tool prints one line instead.

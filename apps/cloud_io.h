@@ -30,8 +30,9 @@ isInputFormat(const std::string& ext);
 bool
 isMeshFormat(const std::string& ext);
 
-/** Read a point cloud (.pcd, .ply, .obj, .xyz/.txt/.pts); on failure return false and
- * say why in \a error. Only the vertices of a mesh file are read. */
+/** Read a point cloud (.pcd, .ply, .obj, .xyz/.txt/.pts, or the registered range
+ * scans a Stanford .conf lists, merged); on failure return false and say why in
+ * \a error. Only the vertices of a mesh file are read. */
 bool
 readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& error);
 

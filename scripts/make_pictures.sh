@@ -25,4 +25,9 @@ if [ -f "$scan" ]; then
   "$tool" "$scan" "$tmp/bunny.vtk" -q -screenshot "$out/bunny_boundary.png"
   "$tool" "$scan" "$tmp/bunny_plain.vtk" -q -no_boundary -screenshot "$out/bunny_plain.png"
 fi
+# The registered scans merged (the .conf lists them with their transforms).
+conf="$data/stanford_bunny_scans/bun.conf"
+if [ -f "$conf" ]; then
+  "$tool" "$conf" "$tmp/bunny_merged.vtk" -q -screenshot "$out/bunny_merged.png"
+fi
 ls -la "$out"

@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <support/surfaces.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -562,4 +564,69 @@ TEST_F(Tool, NoDenoiseKeepsTheNoisyPoints)
   pcl::PCLPointCloud2 blob;
   ASSERT_EQ(pcl::io::loadPCDFile(dir_ + "/raw_o.pcd", blob), 0);
   EXPECT_EQ(std::size_t(blob.width) * blob.height, 0u);
+}
+
+TEST_F(Tool, StanfordConfigurationMergesTheRegisteredScans)
+{
+  // The hemisphere cut into two scans; the second stored in its own frame, which
+  // the configuration's rotation (qx qy qz qw) and translation undo.
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  const Eigen::Vector3d t(0.25, -1.5, 3.0);
+  pcl::PointCloud<pcl::PointXYZ> first, second, merged;
+  for (const auto& p : *cloud_) {
+    const Eigen::Vector3d y = p.getVector3fMap().cast<double>();
+    if (y.x() < 0.0)
+      first.push_back(p);
+    else {
+      const Eigen::Vector3d x = q.toRotationMatrix() * (y - t);
+      second.push_back(pcl::PointXYZ(float(x.x()), float(x.y()), float(x.z())));
+    }
+  }
+  ASSERT_GT(first.size(), 500u);
+  ASSERT_GT(second.size(), 500u);
+  pcl::io::savePLYFileBinary(dir_ + "/first.ply", first);
+  pcl::io::savePLYFileBinary(dir_ + "/second.ply", second);
+  {
+    std::ofstream conf(dir_ + "/scans.conf");
+    conf.precision(17);
+    conf << "camera 0 0 1 0 0 0 1\n"
+         << "bmesh first.ply 0 0 0 0 0 0 1\n"
+         << "bmesh second.ply " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x()
+         << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n'
+         << "bmesh not_scanned.ply 0 0 0 0 0 0 1\n";
+  }
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/scans.conf " + dir_ + "/scans.ply", &log), 0) << log;
+  // A listed scan that is missing is named, the others merged.
+  EXPECT_NE(log.find("1 of the 3 scans listed are missing"), std::string::npos) << log;
+  EXPECT_NE(log.find("not_scanned.ply"), std::string::npos) << log;
+
+  // The output's points are the hemisphere's again, scan by scan.
+  pcl::PolygonMesh mesh;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/scans.ply", mesh), 0);
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(mesh.cloud, points);
+  ASSERT_EQ(points.size(), cloud_->size());
+  double worst = 0.0;
+  std::size_t i = 0;
+  for (const bool in_first : {true, false})
+    for (const auto& p : *cloud_)
+      if ((p.x < 0.0f) == in_first)
+        worst = std::max(
+            worst, double((points[i++].getVector3fMap() - p.getVector3fMap()).norm()));
+  EXPECT_LT(worst, 1e-5);
+  // And its mesh the library's on the hemisphere, up to the float rounding of the
+  // moved points.
+  const double expected = double(libraryTriangles());
+  EXPECT_NEAR(double(mesh.polygons.size()), expected, 0.01 * expected);
+
+  // Nothing listed there: an error, no output.
+  {
+    std::ofstream conf(dir_ + "/empty.conf");
+    conf << "bmesh gone.ply 0 0 0 0 0 0 1\n";
+  }
+  EXPECT_NE(run(dir_ + "/empty.conf " + dir_ + "/empty.ply", &log), 0);
+  EXPECT_NE(log.find("none of the scans"), std::string::npos) << log;
+  EXPECT_FALSE(exists(dir_ + "/empty.ply"));
 }

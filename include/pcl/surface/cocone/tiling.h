@@ -1,0 +1,142 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/repair.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief The smallest core runTiled() accepts: below, a tile's own statistics (the
+ * automatic ratio, the median gap of the half-disk test, the noise level) and its
+ * spacing are read off too few points. */
+constexpr std::size_t MINIMUM_TILE_POINTS = 1000;
+
+/** \brief How runTiled() cuts a cloud into tiles (independent of Parameters). */
+struct TilingOptions {
+  /** At most this many points in the core of a tile; 0, or at least the number of
+   * finite points: one piece (run()). Otherwise at least MINIMUM_TILE_POINTS. */
+  std::size_t tile_points = 0;
+  /** Width of the halo in local spacings s, s the median nearest-neighbour distance
+   * of the core's points. Measured against one piece (random samples, 50,000
+   * points, 16 tiles): the labels of the points near the seams agree from 4 (torus,
+   * sphere with holes) to 6 (monkey saddle, the torus with noise of 0.3 spacings)
+   * on; the triangles of a core are then those of a one-piece run walked with the
+   * same orientation (see runTiled()). The default doubles the largest. */
+  double halo_spacings = 8.0;
+  /** Tiles reconstructed at the same time; 0: one per thread of
+   * Parameters::threads. Peak memory grows with it (each holds one tile's
+   * triangulation); the output does not depend on it. */
+  unsigned int tiles_in_flight = 0;
+};
+
+/** \brief What runTiled() did, beyond the Result. */
+struct TilingReport {
+  /** Number of tiles (1: one piece). */
+  std::size_t tiles = 0;
+  /** Halo points summed over the tiles. */
+  std::size_t halo_points = 0;
+  /** The most points (core and halo) one tile was reconstructed from. */
+  std::size_t largest_tile = 0;
+  /** Per point passed to runTiled(): the tile whose core holds it; -1 if it is not
+   * finite. */
+  std::vector<int> point_tile;
+  /** Per triangle of Result::polygons: the tile that kept it; -1 for a triangle the
+   * stitch added to close a seam hole. */
+  std::vector<int> triangle_tile;
+  /** Patches (connected pieces of the triangles one tile kept) and how many were
+   * turned over to agree with their neighbours across the seams. */
+  std::size_t patches = 0;
+  std::size_t patches_flipped = 0;
+  /** Kept triangles left out because a vertex of theirs is an outlier in the tile
+   * that owns that vertex. */
+  std::size_t seam_dropped = 0;
+  /** What the repair of the stitched mesh changed (at the seams). */
+  RepairCounts stitch;
+  /** Triangles added to close seam holes, from the tiles' own meshes. */
+  std::size_t seam_filled = 0;
+  /** Tiles whose points are degenerate (fewer than 4 distinct, or collinear): their
+   * core points are labelled undersampled and are in no triangle. */
+  std::size_t degenerate_tiles = 0;
+};
+
+/** \brief Reconstruct tile by tile: the result of run() for a cloud too large for
+ * one triangulation.
+ *
+ * The finite points are cut into tiles by recursive median splits along the longest
+ * axis of the points' box (exact duplicates stay together), so that each core holds
+ * at most TilingOptions::tile_points points and every point is in exactly one core.
+ * A tile is its core plus the halo: the other points within TilingOptions::
+ * halo_spacings local spacings of the core's box. run() reconstructs each tile on
+ * its own, with the caller's ids.
+ *
+ * Ownership rule: a triangle is kept by exactly one tile, the one whose core holds
+ * the triangle's vertex with the smallest caller id (the vertex's representative,
+ * Result::representative); the tiles' cores partition the points, so a triangle
+ * found by several tiles is kept once. A point's labels (boundary, outlier, noise
+ * level, normal, position) come from the tile whose core holds it.
+ *
+ * Stitching: the kept triangles are joined; each tile's kept triangles form patches
+ * whose orientation is turned over where the edges shared with the neighbouring
+ * patches say so (the agreement of most shared edges, strongest pairs first); the
+ * union is then made an oriented 2-manifold by repairManifold() (where tiles
+ * disagree at a seam an edge may have three triangles or a vertex two fans), small
+ * seam holes are closed with triangles of the tiles' own meshes (fillHoles()), each
+ * component faces outward, and the border loops are those of the whole mesh.
+ *
+ * The Result's fields read as those of run(): polygons, border_loops,
+ * boundary_indices, outlier_indices and point_noise over the caller's ids,
+ * vertex_of_input for every point (-1 not finite, -2 outlier). The vertices are
+ * numbered in the order of their representatives' positions in \a points (loops
+ * start at their lowest vertex so numbered, triangles are sorted by it); positions
+ * are relative to offset, the centre of the finite points' box. normals are
+ * recomputed against the stitched mesh as run() does. ratio is the median over the
+ * tiles of the ratio each used, noise_level the median of point_noise,
+ * noise_after_smoothing the median over the tiles that tried, smoothed is set if
+ * any tile smoothed; counts and timings are summed over the tiles (their halos
+ * included), and the stitch is added to timings.reconstruction.
+ *
+ * What can still differ from run(), measured on random samples with the default
+ * halo: the walk of stage 7 keeps, where four nearly cocircular points make a flat
+ * tetrahedron whose faces are all candidates, the pair of faces on the side its
+ * orientation faces, and that orientation comes from each walk's seed; a tile walks
+ * one way or the other (each tile's triangles are those of a one-piece run of either
+ * orientation: mirroring the cloud changes 3 % of a one-piece run's triangles on a
+ * random torus), so 0 to 3 % of the triangles differ, the topology does not. Each
+ * tile also chooses the automatic ratio, the gap angle of the half-disk test and
+ * whether to smooth from its own points (with noise the ratio differs most: the
+ * tile's outermost halo points count in its statistics), and the labels of points
+ * on the sampled surface's own border depend on points far along it; a border loop
+ * that runs out of a tile's halo is not closed as an undersampled hole by either
+ * tile.
+ *
+ * The output does not depend on the number of threads or tiles in flight. A tile
+ * that fails for lack of memory fails the run (Result::error); a degenerate tile
+ * does not (TilingReport::degenerate_tiles).
+ *
+ * \param[in] points the points; non-finite points and duplicates are allowed
+ * \param[in] parameters the parameters of every tile's run(); threads are shared
+ *            among the tiles in flight
+ * \param[in] tiling how to cut the cloud
+ * \param[in] ids the caller's id of each point, distinct; empty: the position in
+ *            \a points
+ * \param[out] report if given, what the tiling did
+ */
+Result
+runTiled(std::vector<Eigen::Vector3d> points,
+         const Parameters& parameters,
+         const TilingOptions& tiling,
+         const std::vector<int>& ids = {},
+         TilingReport* report = nullptr);
+
+} // namespace cocone
+} // namespace pcl

@@ -1,0 +1,907 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/repair.h>
+#include <pcl/surface/cocone/tiling.h>
+#include <pcl/surface/cocone/triangulation.h>
+
+#include <Eigen/Geometry>
+
+#include "edge_sort.h"
+#include "parallel.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <new>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <utility>
+
+namespace pcl {
+namespace cocone {
+
+namespace {
+
+/** Seam holes of up to this many edges are closed with the tiles' triangles: where
+ * two tiles disagree the gap is a triangle or two (loops of 3 to 6 edges). */
+constexpr std::size_t SEAM_HOLE_EDGES = 12;
+/** Points sampled for a tile's spacing. */
+constexpr std::size_t SPACING_SAMPLES = 512;
+
+class Stopwatch {
+public:
+  double
+  lap()
+  {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/** The position in the points of each caller id. */
+class IdIndex {
+public:
+  /** False (with \a error) if the ids are not distinct. */
+  bool
+  build(const std::vector<int>& ids, std::string& error)
+  {
+    ids_ = &ids;
+    if (ids.empty())
+      return true;
+    const auto [lo, hi] = std::minmax_element(ids.begin(), ids.end());
+    low_ = *lo;
+    const auto range = static_cast<std::uint64_t>(static_cast<std::int64_t>(*hi) - *lo);
+    if (range < 4 * static_cast<std::uint64_t>(ids.size()) + 1024) {
+      dense_.assign(range + 1, -1);
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        int& slot = dense_[static_cast<std::size_t>(ids[i] - low_)];
+        if (slot >= 0) {
+          error = "the ids are not distinct (" + std::to_string(ids[i]) + " twice)";
+          return false;
+        }
+        slot = static_cast<int>(i);
+      }
+      return true;
+    }
+    sorted_.reserve(ids.size());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      sorted_.emplace_back(ids[i], static_cast<int>(i));
+    std::sort(sorted_.begin(), sorted_.end());
+    for (std::size_t i = 1; i < sorted_.size(); ++i)
+      if (sorted_[i].first == sorted_[i - 1].first) {
+        error =
+            "the ids are not distinct (" + std::to_string(sorted_[i].first) + " twice)";
+        return false;
+      }
+    return true;
+  }
+
+  int
+  id(std::size_t position) const
+  {
+    return ids_->empty() ? static_cast<int>(position) : (*ids_)[position];
+  }
+
+  /** The position of \a id (one of the ids). */
+  int
+  position(int id) const
+  {
+    if (ids_->empty())
+      return id;
+    if (!dense_.empty())
+      return dense_[static_cast<std::size_t>(static_cast<std::int64_t>(id) - low_)];
+    const auto it =
+        std::lower_bound(sorted_.begin(),
+                         sorted_.end(),
+                         std::make_pair(id, std::numeric_limits<int>::min()));
+    return it->second;
+  }
+
+private:
+  const std::vector<int>* ids_ = nullptr;
+  int low_ = 0;
+  std::vector<int> dense_;
+  std::vector<std::pair<int, int>> sorted_;
+};
+
+struct Box {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::max());
+
+  void
+  extend(const Eigen::Vector3d& p)
+  {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+
+  double
+  distance(const Eigen::Vector3d& p) const
+  {
+    return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
+  }
+
+  double
+  distance(const Box& b) const
+  {
+    return (lo - b.hi).cwiseMax(b.lo - hi).cwiseMax(0.0).norm();
+  }
+};
+
+/** The tiles: a k-d tree of median splits over the finite points, its leaves the
+ * cores. */
+class Tiles {
+public:
+  struct Node {
+    std::size_t begin = 0, end = 0; ///< range of order
+    Box box;                        ///< of the node's points
+    int left = -1, right = -1;      ///< children; -1 at a leaf
+  };
+
+  Tiles(const std::vector<Eigen::Vector3d>& points,
+        std::vector<int> finite,
+        std::size_t tile_points)
+  : points_(points), order_(std::move(finite)), tile_points_(tile_points)
+  {
+    nodes_.reserve(4 * (order_.size() / tile_points + 1));
+    nodes_.emplace_back();
+    nodes_[0].end = order_.size();
+    split(0);
+  }
+
+  std::size_t
+  size() const
+  {
+    return leaves_.size();
+  }
+
+  const Node&
+  core(std::size_t tile) const
+  {
+    return nodes_[leaves_[tile]];
+  }
+
+  const std::vector<int>&
+  order() const
+  {
+    return order_;
+  }
+
+  /** The positions of the points not in \a tile's core within \a reach of its box,
+   * in the order of the tiles. */
+  std::vector<int>
+  halo(std::size_t tile, double reach) const
+  {
+    std::vector<int> out;
+    const int own = leaves_[tile];
+    const Box& box = nodes_[own].box;
+    std::vector<int> stack{0};
+    while (!stack.empty()) {
+      const int n = stack.back();
+      stack.pop_back();
+      const Node& node = nodes_[n];
+      if (n == own || node.box.distance(box) > reach)
+        continue;
+      if (node.left >= 0) {
+        stack.push_back(node.right); // the left child first
+        stack.push_back(node.left);
+        continue;
+      }
+      for (std::size_t i = node.begin; i < node.end; ++i)
+        if (box.distance(points_[order_[i]]) <= reach)
+          out.push_back(order_[i]);
+    }
+    return out;
+  }
+
+private:
+  void
+  split(int n)
+  {
+    const std::size_t begin = nodes_[n].begin, end = nodes_[n].end;
+    Box box;
+    for (std::size_t i = begin; i < end; ++i)
+      box.extend(points_[order_[i]]);
+    nodes_[n].box = box;
+    const Eigen::Vector3d extent = box.hi - box.lo;
+    int axis = 0;
+    extent.maxCoeff(&axis);
+    if (end - begin <= tile_points_ || !(extent[axis] > 0.0)) {
+      leaves_.push_back(n);
+      return;
+    }
+    // Along the axis, then by the other coordinates: exact duplicates compare equal
+    // and are kept on one side, so that a vertex has one core.
+    const auto less = [&](int a, int b) {
+      const Eigen::Vector3d &p = points_[a], &q = points_[b];
+      if (p[axis] != q[axis])
+        return p[axis] < q[axis];
+      return std::lexicographical_compare(
+          p.data(), p.data() + 3, q.data(), q.data() + 3);
+    };
+    const auto first = order_.begin() + static_cast<std::ptrdiff_t>(begin);
+    const auto last = order_.begin() + static_cast<std::ptrdiff_t>(end);
+    auto middle = first + static_cast<std::ptrdiff_t>((end - begin) / 2);
+    std::nth_element(first, middle, last, less);
+    const int pivot = *middle;
+    // The pivot's duplicates go right, or left when all of the left are such.
+    auto cut = std::partition(first, middle, [&](int i) { return less(i, pivot); });
+    if (cut == first)
+      cut = std::partition(middle, last, [&](int i) { return !less(pivot, i); });
+    if (cut == first || cut == last) {
+      leaves_.push_back(n);
+      return;
+    }
+    const auto mid = static_cast<std::size_t>(cut - order_.begin());
+    const int left = static_cast<int>(nodes_.size());
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    nodes_[n].left = left;
+    nodes_[n].right = left + 1;
+    nodes_[left].begin = begin;
+    nodes_[left].end = mid;
+    nodes_[left + 1].begin = mid;
+    nodes_[left + 1].end = end;
+    split(left);
+    split(left + 1);
+  }
+
+  const std::vector<Eigen::Vector3d>& points_;
+  std::vector<int> order_;
+  std::size_t tile_points_;
+  std::vector<Node> nodes_;
+  std::vector<int> leaves_;
+};
+
+/** The median distance of the points of \a index to their nearest other point (a
+ * distinct one), over an even sample of them; 0 if all coincide. A grid of cells
+ * about twice the spacing a surface through the box would have; where most samples
+ * find no neighbour within a cell, the cells grow. */
+double
+medianSpacing(const std::vector<Eigen::Vector3d>& P,
+              const int* index,
+              std::size_t n,
+              const Box& box)
+{
+  Eigen::Vector3d e = box.hi - box.lo;
+  std::sort(e.data(), e.data() + 3, std::greater<>());
+  if (n < 2 || !(e[0] > 0.0))
+    return 0.0;
+  double cell = 2.0 * std::sqrt(std::max(e[0] * e[1], e[0] * e[0] * 1e-12) /
+                                static_cast<double>(n));
+  cell = std::max(cell, e[0] / double(1 << 20));
+  const std::size_t samples = std::min(n, SPACING_SAMPLES);
+  std::vector<std::pair<std::uint64_t, int>> keyed(n);
+  std::vector<double> nearest(samples);
+  for (int attempt = 0; attempt < 12; ++attempt, cell *= 4.0) {
+    const auto coordinate = [&](const Eigen::Vector3d& p, int k) {
+      return static_cast<std::int64_t>(std::floor((p[k] - box.lo[k]) / cell));
+    };
+    const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+      return static_cast<std::uint64_t>(x) << 42 | static_cast<std::uint64_t>(y) << 21 |
+             static_cast<std::uint64_t>(z);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d& p = P[index[i]];
+      keyed[i] = {key(coordinate(p, 0), coordinate(p, 1), coordinate(p, 2)), index[i]};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    std::size_t found = 0;
+    for (std::size_t s = 0; s < samples; ++s) {
+      const Eigen::Vector3d& p = P[index[s * n / samples]];
+      const std::int64_t c[3] = {coordinate(p, 0), coordinate(p, 1), coordinate(p, 2)};
+      double best = std::numeric_limits<double>::infinity();
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const std::int64_t x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
+            if (x < 0 || y < 0 || z < 0)
+              continue;
+            const std::uint64_t k = key(x, y, z);
+            auto it =
+                std::lower_bound(keyed.begin(),
+                                 keyed.end(),
+                                 std::make_pair(k, std::numeric_limits<int>::min()));
+            for (; it != keyed.end() && it->first == k; ++it) {
+              const double d = (P[it->second] - p).norm();
+              if (d > 0.0 && d < best)
+                best = d;
+            }
+          }
+      // Within a cell of p every point is in the 27 cells: the nearest is exact.
+      nearest[s] = best <= cell ? best : std::numeric_limits<double>::infinity();
+      found += best <= cell;
+    }
+    if (2 * found > samples) {
+      std::nth_element(nearest.begin(), nearest.begin() + samples / 2, nearest.end());
+      return nearest[samples / 2];
+    }
+  }
+  return 0.0;
+}
+
+/** What one tile leaves for the stitch: the labels of its core, the triangles it
+ * keeps and the others of its mesh. */
+struct TileOutput {
+  /** A failure that fails the run (no memory, no thread). */
+  std::string error;
+  bool degenerate = false;
+  std::size_t points = 0; ///< core and halo
+  /** Per core point, in the order of the core: the caller id of its vertex's
+   * representative, -2 for an outlier. */
+  std::vector<int> representative;
+  /** Per core point: bit 0 boundary, bit 1 umbrella failure. */
+  std::vector<std::uint8_t> flags;
+  /** Per core point its noise level; empty without noise handling. */
+  std::vector<float> noise;
+  /** Per core point that represents its vertex, in the order of the core: the
+   * position (in the caller's frame) and the normal. */
+  std::vector<Eigen::Vector3d> position, normal;
+  /** Kept triangles, oriented, over caller ids. */
+  std::vector<Triangle> kept;
+  /** The tile's other triangles (of the halo), ids ascending: they may close a seam
+   * hole where the tiles that own them disagree. */
+  std::vector<Triangle> seen;
+  double ratio = 0.0;
+  double noise_after_smoothing = 0.0;
+  bool smoothed = false;
+  ReconstructionCounts counts;
+  Timings timings;
+};
+
+void
+add(ReconstructionCounts& a, const ReconstructionCounts& b)
+{
+  a.candidates += b.candidates;
+  a.umbrella_failures += b.umbrella_failures;
+  a.pruned += b.pruned;
+  a.walk_components += b.walk_components;
+  a.walked += b.walked;
+  a.walk_conflicts += b.walk_conflicts;
+  a.walk_reseeds += b.walk_reseeds;
+  a.repair.nonmanifold_edge += b.repair.nonmanifold_edge;
+  a.repair.nonmanifold_vertex += b.repair.nonmanifold_vertex;
+  a.repair.orientation += b.repair.orientation;
+  a.repair.flipped += b.repair.flipped;
+  a.repair.filled += b.repair.filled;
+  a.repair.ribbon += b.repair.ribbon;
+  a.holes_filled += b.holes_filled;
+  a.hole_triangles += b.hole_triangles;
+}
+
+void
+add(Timings& a, const Timings& b)
+{
+  a.unique += b.unique;
+  a.delaunay += b.delaunay;
+  a.noise += b.noise;
+  a.voronoi += b.voronoi;
+  a.boundary += b.boundary;
+  a.reconstruction += b.reconstruction;
+}
+
+double
+median(std::vector<double> v)
+{
+  if (v.empty())
+    return 0.0;
+  const auto m = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), m, v.end());
+  return *m;
+}
+
+/** Reconstruct tile \a t: run() on its core and halo, then what the stitch needs. */
+TileOutput
+reconstructTile(std::size_t t,
+                const std::vector<Eigen::Vector3d>& points,
+                const Tiles& tiles,
+                const IdIndex& ids,
+                const std::vector<int>& point_tile,
+                const Parameters& parameters,
+                double halo_spacings)
+{
+  TileOutput out;
+  const auto& core = tiles.core(t);
+  const int* core_index = tiles.order().data() + core.begin;
+  const std::size_t core_size = core.end - core.begin;
+  const double reach =
+      halo_spacings * medianSpacing(points, core_index, core_size, core.box);
+  std::vector<int> members(core_index, core_index + core_size);
+  {
+    const std::vector<int> halo = tiles.halo(t, reach);
+    members.insert(members.end(), halo.begin(), halo.end());
+  }
+  out.points = members.size();
+  std::vector<Eigen::Vector3d> local;
+  std::vector<int> local_ids;
+  local.reserve(members.size());
+  local_ids.reserve(members.size());
+  for (const int p : members) {
+    local.push_back(points[p]);
+    local_ids.push_back(ids.id(static_cast<std::size_t>(p)));
+  }
+  std::vector<int>().swap(members);
+  Result r = run(std::move(local), parameters, Stages::RECONSTRUCTION, local_ids);
+  if (!r.error.empty() && r.vertex_of_input.size() != local_ids.size()) {
+    out.error = r.error; // out of memory, no thread: nothing to go on with
+    return out;
+  }
+  out.degenerate = !r.error.empty();
+  out.ratio = r.ratio;
+  out.noise_after_smoothing = r.noise_after_smoothing;
+  out.smoothed = r.smoothed;
+  out.counts = r.counts;
+  out.timings = r.timings;
+
+  // The representative of each vertex: its lowest caller id, as run() chooses.
+  std::vector<int> representative(r.vertices, std::numeric_limits<int>::max());
+  for (std::size_t i = 0; i < local_ids.size(); ++i)
+    if (r.vertex_of_input[i] >= 0)
+      representative[r.vertex_of_input[i]] =
+          std::min(representative[r.vertex_of_input[i]], local_ids[i]);
+  out.representative.resize(core_size);
+  out.flags.resize(core_size);
+  const bool noise = r.point_noise.size() == local_ids.size();
+  if (noise)
+    out.noise.assign(r.point_noise.begin(), r.point_noise.begin() + core_size);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < core_size; ++i) {
+    const int v = r.vertex_of_input[i];
+    if (v < 0) {
+      out.representative[i] = -2; // finite, so an outlier
+      continue;
+    }
+    out.representative[i] = representative[v];
+    out.flags[i] = out.degenerate
+                       ? 1
+                       : static_cast<std::uint8_t>((r.boundary[v] ? 1 : 0) |
+                                                   (r.umbrella_failed[v] ? 2 : 0));
+    if (representative[v] != local_ids[i])
+      continue;
+    if (out.degenerate) {
+      out.position.push_back(points[core_index[i]]);
+      out.normal.push_back(Eigen::Vector3d::Constant(nan));
+      continue;
+    }
+    out.position.push_back(r.positions[v] + r.offset);
+    out.normal.push_back(r.normals[v]);
+  }
+
+  // The ownership rule: the tile whose core holds the lowest id keeps the triangle.
+  const auto tile_of = [&](int id) { return point_tile[ids.position(id)]; };
+  const auto own = static_cast<int>(t);
+  for (const Triangle& tri : r.polygons) {
+    const int lowest = std::min({tri[0], tri[1], tri[2]});
+    if (tile_of(lowest) == own)
+      out.kept.push_back(tri);
+    else {
+      Triangle sorted = tri;
+      std::sort(sorted.begin(), sorted.end());
+      out.seen.push_back(sorted);
+    }
+  }
+  return out;
+}
+
+/** Run \a body(t) for t in [0, count) on up to \a workers threads, each tile on one
+ * of them, the next tile to the first thread free. */
+template <typename Body>
+void
+forEachTile(std::size_t count, int workers, const Body& body)
+{
+  if (workers <= 1) {
+    for (std::size_t t = 0; t < count; ++t)
+      body(t);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t t = next++; t < count; t = next++)
+      body(t);
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(static_cast<std::size_t>(workers));
+  try {
+    for (int w = 0; w < workers; ++w)
+      pool.emplace_back(work);
+  }
+  catch (...) { // a thread that could not start: the others finish the tiles
+    for (auto& thread : pool)
+      thread.join();
+    throw;
+  }
+  for (auto& thread : pool)
+    thread.join();
+}
+
+Result
+stitchTiles(std::vector<Eigen::Vector3d>&& points,
+            const Parameters& parameters,
+            const TilingOptions& tiling,
+            const IdIndex& ids,
+            TilingReport& report)
+{
+  Result result;
+  Stopwatch clock;
+  const std::size_t n = points.size();
+  const int threads = resolveThreads(parameters.threads);
+  result.vertex_of_input.assign(n, -1);
+  std::vector<int> finite;
+  Box all;
+  for (std::size_t i = 0; i < n; ++i)
+    if (points[i].allFinite()) {
+      finite.push_back(static_cast<int>(i));
+      all.extend(points[i]);
+    }
+  const Tiles tiles(points, std::move(finite), tiling.tile_points);
+  const std::size_t count = tiles.size();
+  report.tiles = count;
+  report.point_tile.assign(n, -1);
+  for (std::size_t t = 0; t < count; ++t)
+    for (std::size_t i = tiles.core(t).begin; i < tiles.core(t).end; ++i)
+      report.point_tile[tiles.order()[i]] = static_cast<int>(t);
+  const std::vector<int>& point_tile = report.point_tile;
+  result.timings.unique = clock.lap();
+
+  // The tiles, a few at a time: each holds its triangulation while it runs.
+  const int in_flight = static_cast<int>(std::min<std::size_t>(
+      tiling.tiles_in_flight > 0 ? tiling.tiles_in_flight : threads, count));
+  Parameters tile_parameters = parameters;
+  tile_parameters.threads = static_cast<unsigned>(std::max(1, threads / in_flight));
+  std::vector<TileOutput> outputs(count);
+  forEachTile(count, in_flight, [&](std::size_t t) {
+    try {
+      outputs[t] = reconstructTile(
+          t, points, tiles, ids, point_tile, tile_parameters, tiling.halo_spacings);
+    }
+    catch (const std::bad_alloc&) {
+      outputs[t] = TileOutput();
+      outputs[t].error = "out of memory";
+    }
+    catch (const std::exception& e) { // must not leave the thread
+      outputs[t] = TileOutput();
+      outputs[t].error = e.what();
+    }
+  });
+  for (std::size_t t = 0; t < count; ++t)
+    if (!outputs[t].error.empty()) {
+      result.error = "tile " + std::to_string(t) + ": " + outputs[t].error;
+      return result;
+    }
+
+  // Labels per point from the tile of its core; vertices numbered in the order of
+  // their representatives' positions.
+  std::vector<int> representative_of(n, -1);
+  std::vector<std::uint8_t> flags(n, 0);
+  std::vector<int> slot(n, -1); // of a representative: its index in its tile's lists
+  const bool noise = parameters.noise_handling;
+  if (noise)
+    result.point_noise.assign(n, std::numeric_limits<float>::quiet_NaN());
+  std::vector<double> ratios, after;
+  for (std::size_t t = 0; t < count; ++t) {
+    TileOutput& o = outputs[t];
+    const auto& core = tiles.core(t);
+    int k = 0;
+    for (std::size_t i = 0; i < core.end - core.begin; ++i) {
+      const int p = tiles.order()[core.begin + i];
+      representative_of[p] = o.representative[i];
+      flags[p] = o.flags[i];
+      if (o.representative[i] == ids.id(static_cast<std::size_t>(p)))
+        slot[p] = k++;
+      if (noise && !o.noise.empty())
+        result.point_noise[p] = o.noise[i];
+    }
+    std::vector<int>().swap(o.representative);
+    std::vector<std::uint8_t>().swap(o.flags);
+    std::vector<float>().swap(o.noise);
+    report.halo_points += o.points - (core.end - core.begin);
+    report.largest_tile = std::max(report.largest_tile, o.points);
+    report.degenerate_tiles += o.degenerate;
+    if (!o.degenerate)
+      ratios.push_back(o.ratio);
+    if (o.noise_after_smoothing > 0.0)
+      after.push_back(o.noise_after_smoothing);
+    result.smoothed = result.smoothed || o.smoothed;
+    add(result.counts, o.counts);
+    add(result.timings, o.timings);
+  }
+  result.ratio = median(ratios);
+  result.noise_after_smoothing = median(after);
+  if (noise) {
+    std::vector<double> levels;
+    for (const float l : result.point_noise)
+      if (std::isfinite(l))
+        levels.push_back(l);
+    result.noise_level = median(levels);
+  }
+  result.offset = 0.5 * (all.lo + all.hi);
+  std::vector<int> vertex_tile;
+  for (std::size_t p = 0; p < n; ++p)
+    if (slot[p] >= 0) {
+      const auto& o = outputs[point_tile[p]];
+      result.representative.push_back(ids.id(p));
+      result.positions.push_back(o.position[slot[p]] - result.offset);
+      result.normals.push_back(o.normal[slot[p]]);
+      result.boundary.push_back(flags[p] & 1);
+      result.umbrella_failed.push_back((flags[p] >> 1) & 1);
+      slot[p] = static_cast<int>(result.representative.size() - 1);
+    }
+  for (auto& o : outputs) {
+    std::vector<Eigen::Vector3d>().swap(o.position);
+    std::vector<Eigen::Vector3d>().swap(o.normal);
+  }
+  const std::size_t nv = result.representative.size();
+  result.vertices = nv;
+  for (std::size_t p = 0; p < n; ++p) {
+    const int rep = representative_of[p];
+    if (rep == -2) {
+      result.vertex_of_input[p] = -2;
+      result.outlier_indices.push_back(ids.id(p));
+    }
+    else if (rep >= 0) {
+      result.vertex_of_input[p] = slot[ids.position(rep)];
+      if (flags[p])
+        result.boundary_indices.push_back(ids.id(p));
+    }
+  }
+  std::sort(result.outlier_indices.begin(), result.outlier_indices.end());
+  std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
+  std::vector<int>().swap(representative_of);
+  std::vector<int>().swap(slot);
+  std::vector<std::uint8_t>().swap(flags);
+  std::vector<Eigen::Vector3d>().swap(points);
+
+  // The kept triangles over vertex ids; their patches; the tiles' other triangles.
+  const auto vertex = [&](int id) { return result.vertex_of_input[ids.position(id)]; };
+  std::vector<Triangle>& triangles = result.triangles;
+  std::vector<int> tile_of_triangle, patch;
+  std::vector<Triangle> seen;
+  std::size_t patches = 0;
+  for (std::size_t t = 0; t < count; ++t) {
+    TileOutput& o = outputs[t];
+    std::vector<Triangle> mine;
+    mine.reserve(o.kept.size());
+    for (const Triangle& tri : o.kept) {
+      const Triangle v{vertex(tri[0]), vertex(tri[1]), vertex(tri[2])};
+      if (v[0] < 0 || v[1] < 0 || v[2] < 0)
+        ++report.seam_dropped;
+      else
+        mine.push_back(v);
+    }
+    std::vector<Triangle>().swap(o.kept);
+    std::size_t components = 0;
+    const std::vector<int> component = triangleComponents(mine, &components);
+    triangles.insert(triangles.end(), mine.begin(), mine.end());
+    tile_of_triangle.insert(tile_of_triangle.end(), mine.size(), static_cast<int>(t));
+    for (const int c : component)
+      patch.push_back(static_cast<int>(patches) + c);
+    patches += components;
+    for (const Triangle& tri : o.seen) {
+      Triangle v{vertex(tri[0]), vertex(tri[1]), vertex(tri[2])};
+      if (v[0] >= 0 && v[1] >= 0 && v[2] >= 0) {
+        std::sort(v.begin(), v.end());
+        seen.push_back(v);
+      }
+    }
+    std::vector<Triangle>().swap(o.seen);
+  }
+  std::vector<TileOutput>().swap(outputs);
+  report.patches = patches;
+
+  // Patches turned over to agree with their neighbours: per pair of patches the
+  // shared edges vote, the pairs with the clearest vote first (the first pair that
+  // joins two sets decides them).
+  EdgeIncidences incidences(triangles, threads);
+  {
+    std::vector<std::array<int, 3>> votes; // patch, patch, 1 if they agree
+    for (std::size_t e = 0; e < incidences.edges.size(); ++e) {
+      if (incidences.count(e) != 2)
+        continue;
+      const std::size_t i = incidences.first[e];
+      const int a = patch[incidences.triangle[i]],
+                b = patch[incidences.triangle[i + 1]];
+      if (a != b)
+        votes.push_back({std::min(a, b),
+                         std::max(a, b),
+                         incidences.forward[i] != incidences.forward[i + 1]});
+    }
+    std::sort(votes.begin(), votes.end());
+    struct Pair {
+      int a, b;
+      long agree, disagree;
+    };
+    std::vector<Pair> pairs;
+    for (const auto& v : votes) {
+      if (pairs.empty() || pairs.back().a != v[0] || pairs.back().b != v[1])
+        pairs.push_back({v[0], v[1], 0, 0});
+      (v[2] ? pairs.back().agree : pairs.back().disagree) += 1;
+    }
+    std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) {
+      return std::abs(x.agree - x.disagree) > std::abs(y.agree - y.disagree);
+    });
+    detail::ConcurrentParitySets sets(patches, 1);
+    for (const Pair& p : pairs)
+      if (p.agree != p.disagree)
+        sets.unite(p.a, p.b, p.disagree > p.agree ? 1 : 0);
+    std::vector<std::uint8_t> turn(patches, 0), turned(triangles.size(), 0);
+    for (std::size_t c = 0; c < patches; ++c) {
+      turn[c] = static_cast<std::uint8_t>(sets.find(static_cast<int>(c)).parity);
+      report.patches_flipped += turn[c];
+    }
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      if (turn[patch[t]]) {
+        std::swap(triangles[t][1], triangles[t][2]);
+        turned[t] = 1;
+      }
+    for (std::size_t i = 0; i < incidences.triangle.size(); ++i)
+      incidences.forward[i] ^= turned[incidences.triangle[i]];
+  }
+  std::vector<int>().swap(patch);
+
+  // One oriented manifold: the repair of the stitched mesh, then the seam holes.
+  const std::vector<Triangle> before = triangles;
+  repairManifold(result.positions, triangles, report.stitch, threads, &incidences);
+  // Which tile kept each triangle left: the repair keeps their order. The ones it
+  // dropped may close a seam hole again, as may the tiles' triangles others kept.
+  const auto ascending = [](Triangle t) {
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  std::vector<int> kept_by(triangles.size(), -1);
+  for (std::size_t i = 0, j = 0; i < before.size(); ++i)
+    if (j < triangles.size() && ascending(before[i]) == ascending(triangles[j]))
+      kept_by[j++] = tile_of_triangle[i];
+    else
+      seen.push_back(ascending(before[i]));
+  std::vector<int>().swap(tile_of_triangle);
+  std::sort(seen.begin(), seen.end());
+  seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+  // A seam hole of three edges whose triangle no tile made (where tiles triangulate
+  // a flat spot of five or more points differently) is closed by that triangle.
+  const auto border = [&](int a, int b) {
+    const auto e = incidences.find(a, b);
+    return e >= 0 && incidences.count(static_cast<std::size_t>(e)) == 1;
+  };
+  const auto core_of = [&](int v) {
+    return point_tile[ids.position(result.representative[v])];
+  };
+  report.seam_filled = fillHoles(
+      result.positions,
+      triangles,
+      [&](const Triangle& t) {
+        return std::binary_search(seen.begin(), seen.end(), t) ||
+               (border(t[0], t[1]) && border(t[1], t[2]) && border(t[0], t[2]) &&
+                (core_of(t[0]) != core_of(t[1]) || core_of(t[0]) != core_of(t[2])));
+      },
+      SEAM_HOLE_EDGES,
+      &incidences);
+  kept_by.resize(triangles.size(), -1);
+  result.border_loops = boundaryLoops(incidences, nv);
+  incidences = EdgeIncidences();
+  std::vector<Triangle>().swap(seen);
+
+  // A canonical order, as run() gives.
+  struct Kept {
+    Triangle t;
+    int tile;
+  };
+  std::vector<Kept> order(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    Triangle& v = triangles[t];
+    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
+    order[t] = {v, kept_by[t]};
+  }
+  detail::sortByVertexIds(
+      order, nv, [](const Kept& k) { return k.t; }, threads);
+  report.triangle_tile.resize(order.size());
+  for (std::size_t t = 0; t < order.size(); ++t) {
+    triangles[t] = order[t].t;
+    report.triangle_tile[t] = order[t].tile;
+  }
+
+  // Normals against the stitched mesh, as run() turns them.
+  std::vector<Eigen::Vector3d> facing(nv, Eigen::Vector3d::Zero());
+  for (const auto& t : triangles) {
+    const auto& P = result.positions;
+    const Eigen::Vector3d a = (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]);
+    for (const int v : t)
+      facing[v] += a;
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t v = 0; v < nv; ++v) {
+    Eigen::Vector3d& normal = result.normals[v];
+    if (facing[v].squaredNorm() == 0.0)
+      normal = Eigen::Vector3d::Constant(nan);
+    else if (result.boundary[v] || result.umbrella_failed[v] || !normal.allFinite())
+      normal = facing[v].normalized();
+    else if (normal.dot(facing[v]) < 0.0)
+      normal = -normal;
+  }
+
+  result.polygons.reserve(triangles.size());
+  for (const auto& t : triangles)
+    result.polygons.push_back({result.representative[t[0]],
+                               result.representative[t[1]],
+                               result.representative[t[2]]});
+  for (auto& loop : result.border_loops)
+    for (auto& v : loop)
+      v = result.representative[v];
+  result.timings.reconstruction += clock.lap();
+  return result;
+}
+
+} // namespace
+
+Result
+runTiled(std::vector<Eigen::Vector3d> points,
+         const Parameters& parameters,
+         const TilingOptions& tiling,
+         const std::vector<int>& ids,
+         TilingReport* report)
+{
+  TilingReport local;
+  TilingReport& rep = report ? *report : local;
+  rep = TilingReport();
+  Result failed;
+  if (!ids.empty() && ids.size() != points.size()) {
+    failed.error = "ids has " + std::to_string(ids.size()) + " entries for " +
+                   std::to_string(points.size()) + " points";
+    return failed;
+  }
+  if (tiling.tile_points > 0 && tiling.tile_points < MINIMUM_TILE_POINTS) {
+    failed.error = "tile_points must be 0 (one piece) or at least " +
+                   std::to_string(MINIMUM_TILE_POINTS) + " (got " +
+                   std::to_string(tiling.tile_points) + ")";
+    return failed;
+  }
+  if (!(tiling.halo_spacings >= 0.0) || !std::isfinite(tiling.halo_spacings)) {
+    failed.error = "halo_spacings must be finite and >= 0";
+    return failed;
+  }
+  const std::size_t count = points.size();
+  try {
+    IdIndex index;
+    if (!index.build(ids, failed.error))
+      return failed;
+    std::size_t finite = 0;
+    for (const auto& p : points)
+      finite += p.allFinite();
+    if (tiling.tile_points == 0 || finite <= tiling.tile_points) {
+      std::vector<int> tile(count, -1);
+      for (std::size_t i = 0; i < count; ++i)
+        tile[i] = points[i].allFinite() ? 0 : -1;
+      Result r = run(std::move(points), parameters, Stages::RECONSTRUCTION, ids);
+      rep.tiles = 1;
+      rep.largest_tile = finite;
+      rep.point_tile = std::move(tile);
+      rep.triangle_tile.assign(r.polygons.size(), 0);
+      return r;
+    }
+    return stitchTiles(std::move(points), parameters, tiling, index, rep);
+  }
+  catch (const std::bad_alloc&) {
+    failed.error = "out of memory for " + std::to_string(count) + " points";
+  }
+  catch (const std::system_error& e) { // no thread could be started
+    failed.error = std::string("system error: ") + e.what();
+  }
+  rep = TilingReport();
+  return failed;
+}
+
+} // namespace cocone
+} // namespace pcl
