@@ -6,6 +6,7 @@
 #pragma once
 
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/tiling.h>
 #include <pcl/surface/reconstruction.h>
 #include <pcl/memory.h>
 #include <pcl/PointIndices.h>
@@ -219,6 +220,31 @@ public:
   getNumberOfThreads() const
   {
     return parameters_.threads;
+  }
+
+  /** \brief Reconstruct tile by tile (cocone::runTiled()): for clouds too large for
+   * one triangulation in memory.
+   *
+   * The cloud is cut by median splits into tiles of at most this many points, each
+   * reconstructed with a halo of its neighbours' points and one at a time per
+   * thread (see setNumberOfThreads()); every triangle is kept by exactly one tile,
+   * the one holding its lowest input index, and the pieces are stitched into one
+   * oriented manifold whose border loops are those of the whole. Peak memory
+   * follows the tile size. The mesh's topology is that of the one-piece run; on
+   * random samples a few percent of the triangles can differ (the walk's choices at
+   * flat tetrahedra, see cocone::runTiled()). detectBoundary() always runs in one
+   * piece.
+   * \param[in] tile_points 0 (the default): one piece; otherwise at least
+   *            cocone::MINIMUM_TILE_POINTS
+   */
+  void
+  setTilePoints(std::size_t tile_points);
+
+  /** \brief The most points of a tile's core (0: one piece). */
+  std::size_t
+  getTilePoints() const
+  {
+    return tiling_.tile_points;
   }
 
   /** \brief Enable or disable the noise handling.
@@ -435,6 +461,7 @@ private:
   fillPolygons(std::vector<pcl::Vertices>& polygons) const;
 
   cocone::Parameters parameters_;
+  cocone::TilingOptions tiling_;
   cocone::Timings timings_;
   /** The last run: its core result and the cloud size it was indexed against. */
   cocone::Result result_;

@@ -97,6 +97,22 @@ CoConeBoundary<PointInT>::setCoconeAngle(double angle)
 }
 
 template <typename PointInT>
+void
+CoConeBoundary<PointInT>::setTilePoints(std::size_t tile_points)
+{
+  if (tile_points > 0 && tile_points < cocone::MINIMUM_TILE_POINTS) {
+    PCL_ERROR("[pcl::%s::setTilePoints] A tile holds 0 (one piece) or at least %zu "
+              "points (got %zu); keeping %zu.\n",
+              getClassName().c_str(),
+              cocone::MINIMUM_TILE_POINTS,
+              tile_points,
+              tiling_.tile_points);
+    return;
+  }
+  tiling_.tile_points = tile_points;
+}
+
+template <typename PointInT>
 bool
 CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
 {
@@ -122,7 +138,9 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
   }
 
   const std::size_t count = points.size();
-  result_ = cocone::run(std::move(points), parameters_, stages, ids_);
+  result_ = stages == cocone::Stages::RECONSTRUCTION && tiling_.tile_points > 0
+                ? cocone::runTiled(std::move(points), parameters_, tiling_, ids_)
+                : cocone::run(std::move(points), parameters_, stages, ids_);
   timings_ = result_.timings;
   if (!result_.error.empty()) {
     PCL_ERROR("[pcl::%s::%s] No result: %s.\n",
