@@ -43,6 +43,7 @@ struct Options {
   bool noise_handling = true;
   bool fill_holes = true;
   int threads = 1;
+  std::size_t tile_points = 0; // one piece
   std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
 };
 
@@ -75,6 +76,9 @@ printHelp(const char* name)
       "  -no_fill          leave the undersampled holes open (by default a border\n"
       "                    loop that triangles of the local spacing close is closed)\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
+      "  -tile_points N    reconstruct in tiles of at most N points (at least 1000),\n"
+      "                    one per thread at a time, stitched into one mesh: memory\n"
+      "                    follows N (default 0: one piece)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
       "  -outliers FILE    write the outliers (in no triangle) as a .pcd with their\n"
@@ -128,6 +132,7 @@ parseOptions(int argc, char** argv)
                               "-theta",
                               "-cocone_angle",
                               "-threads",
+                              "-tile_points",
                               "-boundary",
                               "-outliers",
                               "-normals",
@@ -176,6 +181,13 @@ parseOptions(int argc, char** argv)
   if (threads < 0.0 || threads != std::floor(threads) || threads > 4096)
     fail("-threads must be a whole number >= 0");
   o.threads = static_cast<int>(threads);
+  const double tile_points = parseNumber(argc, argv, "-tile_points", 0.0);
+  if (tile_points != std::floor(tile_points) || tile_points > 2e9 ||
+      (tile_points != 0.0 &&
+       tile_points < static_cast<double>(pcl::cocone::MINIMUM_TILE_POINTS)))
+    fail("-tile_points must be 0 (one piece) or a whole number of at least " +
+         std::to_string(pcl::cocone::MINIMUM_TILE_POINTS));
+  o.tile_points = static_cast<std::size_t>(tile_points);
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
   o.noise_handling = !find_switch(argc, argv, "-no_denoise");
   o.fill_holes = !find_switch(argc, argv, "-no_fill");
@@ -305,6 +317,7 @@ main(int argc, char** argv)
   cocone.setNoiseHandling(o.noise_handling);
   cocone.setFillUndersampledHoles(o.fill_holes);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
+  cocone.setTilePoints(o.tile_points);
   pcl::PointCloud<pcl::PointXYZ> unused;
   std::vector<pcl::Vertices> polygons;
   cocone.reconstruct(unused, polygons);
