@@ -9,6 +9,8 @@
  *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED [NOISE]]
  *   cocone_benchmark convert CLOUD OUT.ply
  *   cocone_benchmark METHOD CLOUD [--truth auto|closed|saddle|none] [--threads T]
+ *   cocone_benchmark tiled CLOUD --tile_points N [--halo S] [--in_flight K]
+ *                    [--threads T]
  *
  * generate writes seeded samples (area-uniform random or evenly spaced) of the torus
  * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2, with Gaussian noise of NOISE
@@ -21,6 +23,7 @@
  *   gp3                  pcl::GreedyProjectionTriangulation on k = 20 normals
  *   boundary_estimation  pcl::BoundaryEstimation on k = 20 normals
  *   advancing_front      CGAL::advancing_front_surface_reconstruction
+ * (tiled: this library in tiles of at most N points against one piece, see below)
  * and prints one line of key=value fields: seconds, peak_mb (peak resident memory of
  * the process) and base_mb (after reading the cloud), per stage seconds, and the
  * output's triangles, boundary_edges (edges in one triangle) and euler (V - E + F over
@@ -37,6 +40,17 @@
  *           cocone_scan_eval; otherwise none
  * A reported point is correct if a true border point lies within 2 spacings, a true
  * border point is found if a reported one lies that close (scoreBorder()).
+ *
+ * tiled runs the whole reconstruction twice on the cloud, in one piece and with
+ * pcl::cocone::runTiled() (halo S local spacings, K tiles at a time), each in a child
+ * process forked before either starts (so both start from the same memory), one
+ * after the other, and prints for both seconds, peak_mb, triangles, euler, loops
+ * (border loops), manifold (an oriented 2-manifold), components and boundary points,
+ * and between them: differing (triangles, as vertex sets, in one and not the other,
+ * both ways), differing_share (of the one-piece triangles, in percent),
+ * turned (common triangles oriented the other way) and labels_differing (points
+ * undersampled in one run only), with the tiling's tiles, halo_points,
+ * patches_flipped and the stitch's repairs.
  */
 
 #include <pcl/common/io.h>
@@ -46,6 +60,7 @@
 #include <pcl/search/kdtree.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/tiling.h>
 #include <pcl/point_types.h>
 
 #include <CGAL/Delaunay_triangulation_3.h>
@@ -57,6 +72,8 @@
 #include "peer_methods.h"
 #include <support/surfaces.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -333,6 +350,205 @@ boundaryEstimation(const Cloud::Ptr& cloud, Output& out)
   out.has_border = true;
 }
 
+/** What a child process of the tiled comparison reports: its figures... */
+struct PieceFigures {
+  bool ok = false;
+  double seconds = 0.0, peak_mb = 0.0;
+  std::size_t loops = 0, tiles = 0, halo_points = 0, patches_flipped = 0;
+  std::size_t stitch_dropped = 0, seam_filled = 0;
+};
+
+/** ... and its output. */
+struct Piece : PieceFigures {
+  std::vector<Triangle> polygons;
+  std::vector<int> boundary;
+};
+
+template <typename T>
+void
+writeVector(FILE* f, const std::vector<T>& v)
+{
+  const std::size_t n = v.size();
+  std::fwrite(&n, sizeof(n), 1, f);
+  std::fwrite(v.data(), sizeof(T), n, f);
+}
+
+template <typename T>
+bool
+readVector(FILE* f, std::vector<T>& v)
+{
+  std::size_t n = 0;
+  if (std::fread(&n, sizeof(n), 1, f) != 1)
+    return false;
+  v.resize(n);
+  return std::fread(v.data(), sizeof(T), n, f) == n;
+}
+
+/** In a child: the reconstruction, in one piece or tiled, written to \a f. */
+void
+reconstructPiece(std::vector<Eigen::Vector3d> points,
+                 const pcl::cocone::Parameters& parameters,
+                 const pcl::cocone::TilingOptions* tiling,
+                 FILE* f)
+{
+  Stopwatch watch;
+  pcl::cocone::TilingReport report;
+  const pcl::cocone::Result r =
+      tiling
+          ? pcl::cocone::runTiled(std::move(points), parameters, *tiling, {}, &report)
+          : pcl::cocone::run(
+                std::move(points), parameters, pcl::cocone::Stages::RECONSTRUCTION);
+  Piece piece;
+  piece.seconds = watch.seconds();
+  piece.peak_mb = peakMegabytes();
+  piece.ok = r.error.empty();
+  if (!piece.ok)
+    std::fprintf(stderr, "%s\n", r.error.c_str());
+  piece.loops = r.border_loops.size();
+  piece.tiles = report.tiles;
+  piece.halo_points = report.halo_points;
+  piece.patches_flipped = report.patches_flipped;
+  piece.stitch_dropped = report.stitch.dropped();
+  piece.seam_filled = report.seam_filled;
+  std::fwrite(static_cast<PieceFigures*>(&piece), sizeof(PieceFigures), 1, f);
+  writeVector(f, r.polygons);
+  writeVector(f, r.boundary_indices);
+  std::fflush(f);
+}
+
+int
+compareTiled(std::vector<Eigen::Vector3d> points,
+             const pcl::cocone::Parameters& parameters,
+             const pcl::cocone::TilingOptions& tiling)
+{
+  const double base_mb = peakMegabytes();
+  FILE* files[2] = {std::tmpfile(), std::tmpfile()};
+  int go[2];
+  if (!files[0] || !files[1] || pipe(go) != 0) {
+    std::fprintf(stderr, "cannot make the children's files\n");
+    return 1;
+  }
+  // Both children forked now, the second waiting for the first to end: the same
+  // memory at their start, one measurement at a time.
+  pid_t child[2];
+  for (int c = 1; c >= 0; --c) {
+    child[c] = fork();
+    if (child[c] < 0) {
+      std::perror("fork");
+      return 1;
+    }
+    if (child[c] == 0) {
+      char byte;
+      if (c == 1 && read(go[0], &byte, 1) != 1)
+        _exit(1);
+      reconstructPiece(std::move(points), parameters, c ? &tiling : nullptr, files[c]);
+      _exit(0);
+    }
+  }
+  std::vector<Eigen::Vector3d>().swap(points);
+  Piece piece[2];
+  for (int c = 0; c < 2; ++c) {
+    int status = 0;
+    waitpid(child[c], &status, 0);
+    if (c == 0 && write(go[1], "g", 1) != 1)
+      return 1;
+    std::rewind(files[c]);
+    Piece& p = piece[c];
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+        std::fread(static_cast<PieceFigures*>(&p), sizeof(PieceFigures), 1, files[c]) !=
+            1 ||
+        !readVector(files[c], p.polygons) || !readVector(files[c], p.boundary) ||
+        !p.ok) {
+      std::fprintf(stderr, "the %s run failed\n", c ? "tiled" : "one-piece");
+      return 1;
+    }
+  }
+  std::size_t vertices = 0;
+  for (const auto& p : piece)
+    for (const auto& t : p.polygons)
+      vertices =
+          std::max<std::size_t>(vertices, *std::max_element(t.begin(), t.end()) + 1);
+  // Triangles as vertex sets; oriented ones to compare the common ones' turn.
+  std::vector<std::pair<Triangle, Triangle>> sets[2];
+  for (int c = 0; c < 2; ++c) {
+    for (const auto& t : piece[c].polygons) {
+      Triangle key = t;
+      std::sort(key.begin(), key.end());
+      Triangle oriented = t;
+      std::rotate(oriented.begin(),
+                  std::min_element(oriented.begin(), oriented.end()),
+                  oriented.end());
+      sets[c].emplace_back(key, oriented);
+    }
+    std::sort(sets[c].begin(), sets[c].end());
+  }
+  std::size_t differing = 0, turned = 0;
+  for (std::size_t i = 0, j = 0; i < sets[0].size() || j < sets[1].size();) {
+    if (j == sets[1].size() ||
+        (i < sets[0].size() && sets[0][i].first < sets[1][j].first)) {
+      ++differing;
+      ++i;
+    }
+    else if (i == sets[0].size() || sets[1][j].first < sets[0][i].first) {
+      ++differing;
+      ++j;
+    }
+    else {
+      turned += sets[0][i].second != sets[1][j].second;
+      ++i;
+      ++j;
+    }
+  }
+  std::vector<int> labels;
+  std::set_symmetric_difference(piece[0].boundary.begin(),
+                                piece[0].boundary.end(),
+                                piece[1].boundary.begin(),
+                                piece[1].boundary.end(),
+                                std::back_inserter(labels));
+  std::printf(
+      "method=tiled points=%zu tile_points=%zu halo=%g tiles=%zu halo_points=%zu "
+      "base_mb=%.0f",
+      vertices,
+      tiling.tile_points,
+      tiling.halo_spacings,
+      piece[1].tiles,
+      piece[1].halo_points,
+      base_mb);
+  const char* name[2] = {"one", "tiled"};
+  for (int c = 0; c < 2; ++c) {
+    const auto topology = pcl::cocone::analyzeMesh(piece[c].polygons, vertices);
+    std::printf(" %s_seconds=%.3f %s_peak_mb=%.0f %s_triangles=%zu %s_euler=%ld "
+                "%s_loops=%zu %s_manifold=%d %s_components=%zu %s_boundary=%zu",
+                name[c],
+                piece[c].seconds,
+                name[c],
+                piece[c].peak_mb,
+                name[c],
+                piece[c].polygons.size(),
+                name[c],
+                topology.euler,
+                name[c],
+                piece[c].loops,
+                name[c],
+                int(topology.manifold()),
+                name[c],
+                topology.components,
+                name[c],
+                piece[c].boundary.size());
+  }
+  std::printf(" differing=%zu differing_share=%.4f%% turned=%zu labels_differing=%zu "
+              "patches_flipped=%zu stitch_dropped=%zu seam_filled=%zu\n",
+              differing,
+              100.0 * double(differing) /
+                  double(std::max<std::size_t>(1, sets[0].size())),
+              turned,
+              labels.size(),
+              piece[1].patches_flipped,
+              piece[1].stitch_dropped,
+              piece[1].seam_filled);
+  return 0;
+}
+
 int
 usage(const char* program)
 {
@@ -341,7 +557,10 @@ usage(const char* program)
                "       %s convert CLOUD OUT.ply\n"
                "       %s delaunay|detect|cocone|gp3|boundary_estimation|"
                "advancing_front CLOUD\n"
-               "          [--truth auto|closed|saddle|none] [--threads T]\n",
+               "          [--truth auto|closed|saddle|none] [--threads T]\n"
+               "       %s tiled CLOUD --tile_points N [--halo S] [--in_flight K] "
+               "[--threads T]\n",
+               program,
                program,
                program,
                program);
@@ -383,6 +602,7 @@ main(int argc, char** argv)
     return generate(argc, argv);
   std::string truth_kind = "auto";
   unsigned threads = 1;
+  pcl::cocone::TilingOptions tiling;
   if (method != "convert" && argc % 2 == 0)
     return usage(argv[0]); // an option without its value
   for (int a = 3; a + 1 < argc; a += 2) {
@@ -390,6 +610,12 @@ main(int argc, char** argv)
       truth_kind = argv[a + 1];
     else if (std::strcmp(argv[a], "--threads") == 0)
       threads = std::strtoul(argv[a + 1], nullptr, 10);
+    else if (method == "tiled" && std::strcmp(argv[a], "--tile_points") == 0)
+      tiling.tile_points = std::strtoul(argv[a + 1], nullptr, 10);
+    else if (method == "tiled" && std::strcmp(argv[a], "--halo") == 0)
+      tiling.halo_spacings = std::strtod(argv[a + 1], nullptr);
+    else if (method == "tiled" && std::strcmp(argv[a], "--in_flight") == 0)
+      tiling.tiles_in_flight = std::strtoul(argv[a + 1], nullptr, 10);
     else
       return usage(argv[0]);
   }
@@ -404,6 +630,13 @@ main(int argc, char** argv)
       return 1;
     }
     return 0;
+  }
+  if (method == "tiled") {
+    if (tiling.tile_points == 0)
+      return usage(argv[0]);
+    pcl::cocone::Parameters parameters;
+    parameters.threads = threads;
+    return compareTiled(std::move(points), parameters, tiling);
   }
   // The PCL methods take a PCL cloud; the others do not pay for one.
   const bool pcl_input = method == "gp3" || method == "boundary_estimation";
