@@ -346,6 +346,41 @@ TEST(TilingOptions, BadOptionsGiveAnError)
                    .error.empty()); // ids not distinct
   // No points, or too few: run()'s error, no crash.
   EXPECT_FALSE(pcl::cocone::runTiled({}, Parameters(), tiling).error.empty());
+  // No tile with a mesh (one point many times, points on a line): no result either.
+  const std::vector<Eigen::Vector3d> same(5000, Eigen::Vector3d(1.0, 2.0, 3.0));
+  EXPECT_FALSE(pcl::cocone::runTiled(same, Parameters(), tiling).error.empty());
+  std::vector<Eigen::Vector3d> line;
+  for (int i = 0; i < 5000; ++i)
+    line.emplace_back(0.001 * i, 0.002 * i, 0.0);
+  EXPECT_FALSE(pcl::cocone::runTiled(line, Parameters(), tiling).error.empty());
+}
+
+TEST(TilingInput, ADegenerateTileLeavesTheOthers)
+{
+  // A sphere and, far from it, a segment of collinear points: the segment's tiles
+  // have no mesh, their points are undersampled.
+  Sample s = cocone_test::sphere(options(8000, 0.0, 1.0, false));
+  std::vector<Eigen::Vector3d> points = s.points;
+  const std::size_t n = points.size();
+  for (int i = 0; i < 4000; ++i)
+    points.emplace_back(10.0 + 0.01 * i, 0.0, 0.0);
+  TilingOptions tiling;
+  tiling.tile_points = 2000;
+  TilingReport report;
+  const Result r = pcl::cocone::runTiled(points, Parameters(), tiling, {}, &report);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_GE(report.degenerate_tiles, 1u);
+  std::vector<Triangle> triangles = r.polygons;
+  const auto topology = pcl::cocone::analyzeMesh(triangles, points.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.euler, 2);
+  for (const auto& t : r.polygons)
+    for (const int v : t)
+      EXPECT_LT(static_cast<std::size_t>(v), n);
+  std::size_t undersampled = 0;
+  for (const int i : r.boundary_indices)
+    undersampled += static_cast<std::size_t>(i) >= n;
+  EXPECT_EQ(undersampled, 4000u);
 }
 
 TEST(TilingOptions, OnePieceWhenTheTileHoldsTheCloud)

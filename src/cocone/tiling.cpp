@@ -339,7 +339,8 @@ medianSpacing(const std::vector<Eigen::Vector3d>& P,
 struct TileOutput {
   /** A failure that fails the run (no memory, no thread). */
   std::string error;
-  bool degenerate = false;
+  /** Why the tile's points give no mesh (run()'s error); empty if they do. */
+  std::string degenerate;
   std::size_t points = 0; ///< core and halo
   /** Per core point, in the order of the core: the caller id of its vertex's
    * representative, -2 for an outlier. */
@@ -440,7 +441,7 @@ reconstructTile(std::size_t t,
     out.error = r.error; // out of memory, no thread: nothing to go on with
     return out;
   }
-  out.degenerate = !r.error.empty();
+  out.degenerate = r.error;
   out.ratio = r.ratio;
   out.noise_after_smoothing = r.noise_after_smoothing;
   out.smoothed = r.smoothed;
@@ -466,13 +467,13 @@ reconstructTile(std::size_t t,
       continue;
     }
     out.representative[i] = representative[v];
-    out.flags[i] = out.degenerate
+    out.flags[i] = !out.degenerate.empty()
                        ? 1
                        : static_cast<std::uint8_t>((r.boundary[v] ? 1 : 0) |
                                                    (r.umbrella_failed[v] ? 2 : 0));
     if (representative[v] != local_ids[i])
       continue;
-    if (out.degenerate) {
+    if (!out.degenerate.empty()) {
       out.position.push_back(points[core_index[i]]);
       out.normal.push_back(Eigen::Vector3d::Constant(nan));
       continue;
@@ -582,6 +583,14 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
       result.error = "tile " + std::to_string(t) + ": " + outputs[t].error;
       return result;
     }
+  // No tile with a mesh: as run() on the whole would, no result.
+  if (std::all_of(outputs.begin(), outputs.end(), [](const TileOutput& o) {
+        return !o.degenerate.empty();
+      })) {
+    result.error = outputs[0].degenerate;
+    result.vertex_of_input.clear();
+    return result;
+  }
 
   // Labels per point from the tile of its core; vertices numbered in the order of
   // their representatives' positions.
@@ -610,8 +619,8 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     std::vector<float>().swap(o.noise);
     report.halo_points += o.points - (core.end - core.begin);
     report.largest_tile = std::max(report.largest_tile, o.points);
-    report.degenerate_tiles += o.degenerate;
-    if (!o.degenerate)
+    report.degenerate_tiles += !o.degenerate.empty();
+    if (o.degenerate.empty())
       ratios.push_back(o.ratio);
     if (o.noise_after_smoothing > 0.0)
       after.push_back(o.noise_after_smoothing);
