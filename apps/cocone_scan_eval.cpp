@@ -73,7 +73,9 @@ runCocone(const Cloud::Ptr& cloud,
           const char* name,
           double ratio,
           double spacing_factor,
-          double gap_angle)
+          double gap_angle,
+          bool fill = true,
+          bool denoise = true)
 {
   const auto t = std::chrono::steady_clock::now();
   pcl::CoConeBoundary<pcl::PointXYZ> cocone;
@@ -81,6 +83,8 @@ runCocone(const Cloud::Ptr& cloud,
   cocone.setRatio(ratio);
   cocone.setSpacingFactor(spacing_factor);
   cocone.setGapAngle(gap_angle);
+  cocone.setFillUndersampledHoles(fill);
+  cocone.setNoiseHandling(denoise);
   pcl::PolygonMesh mesh;
   cocone.reconstruct(mesh);
   const double sec = since(t);
@@ -141,6 +145,10 @@ main(int argc, char** argv)
 
     const pcl::cocone::Parameters defaults;
     runCocone(cloud, truth, "cocone default", 0.0, 3.0, defaults.gap_angle);
+    // What the hole filling and the smoothing each change on a scan.
+    runCocone(cloud, truth, "no fill", 0.0, 3.0, defaults.gap_angle, false);
+    runCocone(
+        cloud, truth, "no fill/denoise", 0.0, 3.0, defaults.gap_angle, false, false);
     runCocone(cloud, truth, "cocone paper", 1.5, 0.0, 0.0);
     runCocone(cloud, truth, "cocone paper", 2.5, 0.0, 0.0);
 

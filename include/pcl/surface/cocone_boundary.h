@@ -269,7 +269,7 @@ public:
    *
    * After the reconstruction every border loop of up to 1,000 edges is closed when
    * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces finds a
-   * patch whose new edges are all at most 2 local spacings long: an undersampled
+   * patch whose new edges are all at most 2.75 local spacings long: an undersampled
    * hole has samples all around it that continue the surface at that spacing,
    * where the sampled surface really ends nothing is that close across. No new
    * vertex; the mesh stays an oriented manifold. getBoundaryPointIndices() is not
