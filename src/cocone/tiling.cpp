@@ -556,7 +556,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     for (std::size_t i = tiles.core(t).begin; i < tiles.core(t).end; ++i)
       report.point_tile[tiles.order()[i]] = static_cast<int>(t);
   const std::vector<int>& point_tile = report.point_tile;
-  result.timings.unique = clock.lap();
+  report.cut_ms = clock.lap();
 
   // The tiles, a few at a time: each holds its triangulation while it runs.
   const int in_flight = static_cast<int>(std::min<std::size_t>(
@@ -578,6 +578,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
       outputs[t].error = e.what();
     }
   });
+  report.tiles_ms = clock.lap();
   for (std::size_t t = 0; t < count; ++t)
     if (!outputs[t].error.empty()) {
       result.error = "tile " + std::to_string(t) + ": " + outputs[t].error;
@@ -849,7 +850,9 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
   for (auto& loop : result.border_loops)
     for (auto& v : loop)
       v = result.representative[v];
-  result.timings.reconstruction += clock.lap();
+  report.stitch_ms = clock.lap();
+  result.timings.unique += report.cut_ms;
+  result.timings.reconstruction += report.stitch_ms;
   return result;
 }
 
