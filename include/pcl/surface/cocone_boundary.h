@@ -252,7 +252,7 @@ public:
    * Outliers, points off the surface their neighbours sample (flying pixels, points
    * far from everything), are set aside: in no triangle, reported by
    * getOutlierIndices(). When the cloud's noise level (getNoiseLevel()) exceeds 0.1
-   * (and is at most 1.2: above, the neighbourhoods are no surface patches) every
+   * (and is at most 1.05: above, the neighbourhoods are no surface patches) every
    * decision is taken on a copy of the points projected twice onto local degree-2
    * jets, provided this took the noise out (isSmoothed()); the mesh still indexes
    * the input points. A clean cloud without outliers keeps its result.
@@ -309,7 +309,7 @@ public:
   /** \brief The noise level of the cloud in the last run read again on the smoothed
    * points (same neighbours): smoothing is kept when it leaves at most half of
    * getNoiseLevel() (isSmoothed()); 0 if smoothing was not tried (the cloud's level
-   * at most 0.1 or above 1.2, or no noise handling). */
+   * at most 0.1 or above 1.05, or no noise handling). */
   double
   getNoiseLevelAfterSmoothing() const
   {

@@ -54,7 +54,7 @@ struct Parameters {
   /** Border loops longer than this many edges stay open. */
   std::size_t max_hole_edges = 1000;
   /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
-   * cloud's noise level exceeds noise_threshold (and is at most 1.2: above, the
+   * cloud's noise level exceeds noise_threshold (and is at most 1.05: above, the
    * neighbourhoods are no surface patches) every decision is taken on a smoothed
    * copy of the points (smoothPoints()), the mesh still indexing the caller's
    * points, provided the smoothing took the noise out (left at most half the level:
