@@ -53,9 +53,9 @@ struct TilingReport {
   /** Per triangle of Result::polygons: the tile that kept it; -1 for a triangle the
    * stitch added to close a seam hole. */
   std::vector<int> triangle_tile;
-  /** Patches (connected pieces of the triangles one tile kept) and how many were
-   * turned over to agree with their neighbours across the seams. */
+  /** Patches: connected pieces of the triangles one tile kept. */
   std::size_t patches = 0;
+  /** Patches turned over to agree with their neighbours across the seams. */
   std::size_t patches_flipped = 0;
   /** Kept triangles left out because a vertex of theirs is an outlier in the tile
    * that owns that vertex. */
@@ -64,9 +64,12 @@ struct TilingReport {
   RepairCounts stitch;
   /** Triangles added to close seam holes, from the tiles' own meshes. */
   std::size_t seam_filled = 0;
-  /** Wall-clock time of cutting the tiles, of reconstructing them and of the stitch,
-   * in milliseconds. */
-  double cut_ms = 0.0, tiles_ms = 0.0, stitch_ms = 0.0;
+  /** Wall-clock time of cutting the cloud into tiles, in milliseconds. */
+  double cut_ms = 0.0;
+  /** Wall-clock time of reconstructing the tiles, in milliseconds. */
+  double tiles_ms = 0.0;
+  /** Wall-clock time of the stitch, in milliseconds. */
+  double stitch_ms = 0.0;
   /** Tiles whose points are degenerate (fewer than 4 distinct, or collinear): their
    * core points are labelled undersampled and are in no triangle. */
   std::size_t degenerate_tiles = 0;
