@@ -783,3 +783,27 @@ TEST(HoleFilling, TrueHolesSixSpacingsAcrossStayOpen)
     EXPECT_EQ(m.topology.euler, 2 - 6);
   }
 }
+
+TEST(HoleFilling, CoarseTubeComesOutClosed)
+{
+  // A knotted tube with about 8 samples around its circumference: the flatness test
+  // flags every point (the Voronoi cells are not long and thin), so the boundary-
+  // aware mesh is empty; the original Co-cone's triangles make the closed tube.
+  const auto s = cocone_test::tube(cocone_test::options(10000));
+  pcl::cocone::Parameters off;
+  off.fill_undersampled_holes = false;
+  const auto open =
+      pcl::cocone::run(s.points, off, pcl::cocone::Stages::RECONSTRUCTION);
+  EXPECT_LT(open.triangles.size(), s.points.size() / 10);
+  const auto r = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const auto m = cocone_test::scoreMesh(s, r);
+  std::printf("[ measured ] coarse tube: %s\n", m.str().c_str());
+  EXPECT_TRUE(m.topology.manifold()) << m.str();
+  EXPECT_EQ(m.loops, 0u);
+  EXPECT_EQ(m.topology.components, 1u);
+  EXPECT_EQ(m.topology.euler, 0);
+  EXPECT_GT(m.volume, 0.0);
+  // The labels stay the flatness test's (the paper's output).
+  EXPECT_EQ(r.boundary_indices, open.boundary_indices);
+}

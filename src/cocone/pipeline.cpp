@@ -50,6 +50,68 @@ private:
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
+/** Stages 5-7 and the repair over stage 4's candidates: the oriented manifold
+ * mesh, its edge incidences, and per vertex whether it failed the umbrella check. */
+struct WalkedMesh {
+  std::vector<Triangle> triangles;
+  EdgeIncidences incidences;
+  std::vector<std::uint8_t> umbrella_failed;
+};
+
+WalkedMesh
+walkCandidates(const std::vector<Eigen::Vector3d>& points,
+               const std::vector<Triangle>& candidates,
+               const std::vector<std::uint8_t>& labels,
+               int threads,
+               ReconstructionCounts& counts)
+{
+  WalkedMesh mesh;
+  const TriangleComplex complex(points, candidates, threads);
+  std::vector<std::uint8_t> umbrella_triangles;
+  mesh.umbrella_failed =
+      umbrellaFailures(complex, labels, &umbrella_triangles, threads);
+  std::vector<std::uint8_t> boundary = labels;
+  for (std::size_t v = 0; v < boundary.size(); ++v)
+    if (mesh.umbrella_failed[v]) {
+      boundary[v] = 1;
+      ++counts.umbrella_failures;
+    }
+  const std::vector<std::uint8_t> present =
+      prune(complex, boundary, &counts.pruned, umbrella_triangles);
+  WalkResult walked = walk(complex, present, boundary, threads);
+  counts.walk_components = walked.components;
+  counts.walked = walked.triangles.size();
+  counts.walk_conflicts = walked.conflicts;
+  counts.walk_reseeds = walked.reseeds;
+  // Read off the complex, then kept by the repair, the edge incidences serve the
+  // steps after it.
+  mesh.incidences = walkedIncidences(complex, walked, threads);
+  mesh.triangles = std::move(walked.triangles);
+  repairManifold(points, mesh.triangles, counts.repair, threads, &mesh.incidences);
+  return mesh;
+}
+
+/** The original Co-cone's mesh (every vertex chooses) over the vertices of the
+ * \a region and the co-cone triangles among them. */
+std::vector<Triangle>
+plainCoconeMesh(const std::vector<Eigen::Vector3d>& points,
+                const VoronoiCells& cells,
+                const std::vector<std::uint8_t>& region,
+                int threads)
+{
+  const std::vector<std::uint8_t> none(points.size(), 0);
+  std::vector<Triangle> candidates = selectCandidates(cells, none);
+  candidates.erase(std::remove_if(candidates.begin(),
+                                  candidates.end(),
+                                  [&](const Triangle& t) {
+                                    return !region[t[0]] || !region[t[1]] ||
+                                           !region[t[2]];
+                                  }),
+                   candidates.end());
+  ReconstructionCounts scratch;
+  return walkCandidates(points, candidates, none, threads, scratch).triangles;
+}
+
 /** Stages 4-7 and the repair: the oriented manifold mesh over vertex ids. */
 void
 reconstruct(Triangulation& dt,
@@ -65,31 +127,14 @@ reconstruct(Triangulation& dt,
   counts.candidates = candidates.size();
   dt.release(); // the cells are no longer needed: make room for stages 5-7
   const int threads = resolveThreads(parameters.threads);
-  const TriangleComplex complex(dt.points, candidates, threads);
-
-  std::vector<std::uint8_t> umbrella_triangles;
-  result.umbrella_failed =
-      umbrellaFailures(complex, result.boundary, &umbrella_triangles, threads);
+  WalkedMesh mesh =
+      walkCandidates(dt.points, candidates, result.boundary, threads, counts);
+  result.umbrella_failed = std::move(mesh.umbrella_failed);
   std::vector<std::uint8_t> boundary = result.boundary;
   for (std::size_t v = 0; v < boundary.size(); ++v)
-    if (result.umbrella_failed[v]) {
-      boundary[v] = 1;
-      ++counts.umbrella_failures;
-    }
-
-  const std::vector<std::uint8_t> present =
-      prune(complex, boundary, &counts.pruned, umbrella_triangles);
-  WalkResult walked = walk(complex, present, boundary, threads);
-  counts.walk_components = walked.components;
-  counts.walked = walked.triangles.size();
-  counts.walk_conflicts = walked.conflicts;
-  counts.walk_reseeds = walked.reseeds;
-
-  // Read off the complex, then kept by the repair, the edge incidences serve the
-  // steps after it.
-  EdgeIncidences incidences = walkedIncidences(complex, walked, threads);
-  result.triangles = std::move(walked.triangles);
-  repairManifold(dt.points, result.triangles, counts.repair, threads, &incidences);
+    boundary[v] |= result.umbrella_failed[v];
+  EdgeIncidences& incidences = mesh.incidences;
+  result.triangles = std::move(mesh.triangles);
   if (parameters.fill_hole_edges >= 3) {
     // A hole is closed with triangles whose dual Voronoi edge meets a co-cone.
     const auto cocone_triangle = [&](const Triangle& t) {
@@ -126,6 +171,41 @@ reconstruct(Triangulation& dt,
     counts.holes_filled = filled.holes;
     counts.hole_triangles = filled.triangles;
     result.filled_hole_sizes = filled.sizes;
+    // What the Delaunay patches leave (loops, points in no triangle) the original
+    // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
+    // coarsely for the flatness test. Only there, and two rings around, does that
+    // mesh need making.
+    const std::size_t n = dt.points.size();
+    std::vector<std::uint8_t> region(n, 1);
+    for (const auto& t : result.triangles)
+      for (const int v : t)
+        region[v] = 0;
+    for (const auto& loop : result.border_loops)
+      if (loop.size() <= parameters.max_hole_edges)
+        for (const int v : loop)
+          region[v] = 1;
+    if (std::find(region.begin(), region.end(), 1) != region.end()) {
+      for (int ring = 0; ring < 2; ++ring) {
+        std::vector<std::uint8_t> grown = region;
+        for (const auto& t : cells.triangles)
+          if (region[t.v[0]] || region[t.v[1]] || region[t.v[2]])
+            grown[t.v[0]] = grown[t.v[1]] = grown[t.v[2]] = 1;
+        region = std::move(grown);
+      }
+      const HoleFilling plain =
+          fillHolesFromMesh(dt.points,
+                            spacing,
+                            plainCoconeMesh(dt.points, cells, region, threads),
+                            result.triangles,
+                            incidences,
+                            result.border_loops,
+                            parameters.hole_reach,
+                            parameters.max_hole_edges);
+      counts.holes_filled += plain.holes;
+      counts.hole_triangles += plain.triangles;
+      result.filled_hole_sizes.insert(
+          result.filled_hole_sizes.end(), plain.sizes.begin(), plain.sizes.end());
+    }
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

@@ -64,5 +64,38 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       double reach,
                       std::size_t max_edges);
 
+/** \brief Close border loops, and cover points no triangle uses, with the triangles
+ * another mesh of the same vertices has there: the original Co-cone's, every vertex
+ * choosing (the flatness test flags every point of a part sampled too coarsely for
+ * it, a tube with a few samples around, so the boundary-aware mesh has nothing
+ * there, while the Co-cone triangles still make the surface).
+ *
+ * A loop is closed by the triangles of \a other reached from its edges, on the side
+ * away from the mesh, without crossing an edge of the mesh or a border of
+ * \a other: they must make a disk whose border is the loop and whose inner
+ * vertices no triangle of the mesh uses, and face as the mesh does (\a other turned
+ * over if it faces the other way), every new edge at most \a reach local spacings
+ * long as in fillUndersampledHoles() (where the original Co-cone covers a true
+ * border's opening, it does so with long triangles). A closed component of \a other
+ * with such edges, none of whose vertices the mesh uses, is added as it is.
+ * \param[in] points the vertex positions
+ * \param[in] spacing per vertex its local spacing (localSpacing())
+ * \param[in] other an oriented manifold mesh of the same vertices
+ * \param[in,out] triangles the oriented manifold mesh; the patches are appended
+ * \param[in,out] incidences the mesh's edge incidences, kept up to date
+ * \param[in,out] loops the mesh's border loops; the closed ones are taken out
+ * \param[in] reach the longest new edge allowed, in local spacings
+ * \param[in] max_edges loops longer than this are left open
+ */
+HoleFilling
+fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
+                  const std::vector<double>& spacing,
+                  const std::vector<Triangle>& other,
+                  std::vector<Triangle>& triangles,
+                  EdgeIncidences& incidences,
+                  std::vector<std::vector<int>>& loops,
+                  double reach,
+                  std::size_t max_edges);
+
 } // namespace cocone
 } // namespace pcl
