@@ -46,6 +46,19 @@ edgeKey(int a, int b)
   return {std::min(a, b), std::max(a, b)};
 }
 
+/** Whether edge ab is at most \a reach times the larger local spacing of its ends
+ * long: as short as the triangles of the sampling there. */
+bool
+withinReach(const std::vector<Eigen::Vector3d>& points,
+            const std::vector<double>& spacing,
+            double reach,
+            int a,
+            int b)
+{
+  const double longest = reach * std::max(spacing[a], spacing[b]);
+  return (points[a] - points[b]).squaredNorm() <= longest * longest;
+}
+
 Kernel::Point_3
 toCgal(const Eigen::Vector3d& p)
 {
@@ -104,9 +117,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       if (j == i + 1 || (i == 0 && j == static_cast<int>(k) - 1))
         return true; // an edge of the loop
       const int a = hole[i], b = hole[j];
-      const double longest = reach * std::max(spacing[a], spacing[b]);
-      return (points[a] - points[b]).squaredNorm() <= longest * longest &&
-             incidences.find(a, b) < 0;
+      return withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0;
     };
     bool closed = patch.size() == k - 2;
     for (const auto& t : patch)
@@ -147,8 +158,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   // As short as the Delaunay patches' edges: where the original Co-cone covers a
   // true border's hole, it does so with long triangles.
   const auto short_edge = [&](int a, int b) {
-    const double longest = reach * std::max(spacing[a], spacing[b]);
-    return (points[a] - points[b]).squaredNorm() <= longest * longest;
+    return withinReach(points, spacing, reach, a, b);
   };
   const EdgeIncidences theirs(other);
   const std::size_t before = triangles.size();

@@ -20,9 +20,9 @@
 #include <Eigen/Geometry>
 
 #include "edge_sort.h"
+#include "stopwatch.h"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 #include <new>
 #include <string>
@@ -33,22 +33,6 @@ namespace pcl {
 namespace cocone {
 
 namespace {
-
-class Stopwatch {
-public:
-  /** Milliseconds since the last call (or construction). */
-  double
-  lap()
-  {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
-private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
 
 /** Stages 5-7 and the repair over stage 4's candidates: the oriented manifold
  * mesh, its edge incidences, and per vertex whether it failed the umbrella check. */
@@ -326,7 +310,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
 {
   Result result;
   const int threads = resolveThreads(parameters.threads);
-  Stopwatch clock;
+  detail::Stopwatch clock;
   const auto id = [&](std::size_t i) {
     return ids.empty() ? static_cast<int>(i) : ids[i];
   };

@@ -12,10 +12,10 @@
 
 #include "edge_sort.h"
 #include "parallel.h"
+#include "stopwatch.h"
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -36,21 +36,6 @@ namespace {
 constexpr std::size_t SEAM_HOLE_EDGES = 12;
 /** Points sampled for a tile's spacing. */
 constexpr std::size_t SPACING_SAMPLES = 512;
-
-class Stopwatch {
-public:
-  double
-  lap()
-  {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
-private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
 
 /** The position in the points of each caller id. */
 class IdIndex {
@@ -537,7 +522,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
             TilingReport& report)
 {
   Result result;
-  Stopwatch clock;
+  detail::Stopwatch clock;
   const std::size_t n = points.size();
   const int threads = resolveThreads(parameters.threads);
   result.vertex_of_input.assign(n, -1);
