@@ -53,12 +53,14 @@ printHelp(const char* name)
   print_info(
       "Reconstruct a surface from a point cloud with the boundary-aware Co-cone\n"
       "(Dey & Giesen 2001): holes, open borders and sharp features are\n"
-      "detected as undersampled and left open.\n\n");
+      "detected as undersampled; the mesh stays open where the sampled surface\n"
+      "ends and closes the holes the surface goes on across (-no_fill: all open).\n\n");
   print_info("Syntax: %s INPUT OUTPUT [options]\n\n", name);
   print_info(
       "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .xyz/.txt (x y "
-      "z "
-      "per line)\n"
+      "z per line),\n"
+      "          .conf (registered range scans, Stanford's format: the scans it lists, "
+      "merged)\n"
       "  OUTPUT  .vtk (legacy, what pcl_viewer opens), .ply, .obj, .stl\n\n"
       "  -rho R            ratio of the flatness test; 0 (default) chooses it from "
       "the\n"
