@@ -446,7 +446,7 @@ main(int argc, char** argv)
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
       << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
       << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
-      << ", \"threads\": " << o.threads
+      << ", \"tile_points\": " << o.tile_points << ", \"threads\": " << o.threads
       << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
       << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")

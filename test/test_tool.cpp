@@ -630,3 +630,31 @@ TEST_F(Tool, StanfordConfigurationMergesTheRegisteredScans)
   EXPECT_NE(log.find("none of the scans"), std::string::npos) << log;
   EXPECT_FALSE(exists(dir_ + "/empty.ply"));
 }
+
+TEST_F(Tool, TilePointsRunsInTilesAndSaysSo)
+{
+  // A sphere of 6,000 points in tiles of at most 1,000: closed, the same topology as
+  // one piece, and the report names the tile size.
+  cocone_test::SampleOptions o;
+  o.n = 6000;
+  savePoints(dir_ + "/tiles.pcd", cocone_test::sphere(o).points);
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/tiles.pcd " + dir_ + "/tiles.ply -tile_points 1000 -report " +
+                    dir_ + "/tiles.json",
+                &log),
+            0)
+      << log;
+  pcl::PolygonMesh tiled, whole;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/tiles.ply", tiled), 0);
+  ASSERT_EQ(run(dir_ + "/tiles.pcd " + dir_ + "/whole.ply", &log), 0) << log;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/whole.ply", whole), 0);
+  // Closed over the same points, both have 2 V - 4 triangles.
+  EXPECT_EQ(tiled.polygons.size(), whole.polygons.size());
+  const std::string json = slurpText(dir_ + "/tiles.json");
+  EXPECT_NE(json.find("\"tile_points\": 1000"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"boundary_loops\": 0,"), std::string::npos) << json;
+
+  EXPECT_NE(run(dir_ + "/tiles.pcd " + dir_ + "/bad.ply -tile_points 5", &log), 0);
+  EXPECT_NE(log.find("-tile_points must be"), std::string::npos) << log;
+  EXPECT_FALSE(exists(dir_ + "/bad.ply"));
+}
