@@ -8,6 +8,7 @@
  */
 
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/tiling.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -40,7 +41,7 @@ struct Result {
 const char* const PARAMETER_NAMES =
     "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
     "noise_handling, noise_threshold, smoothing_iterations, fill_undersampled_holes, "
-    "threads";
+    "threads, tile_points (reconstruct only)";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -112,7 +113,9 @@ toInt(const char* function,
  * (include/pcl/surface/impl/cocone_boundary.hpp): an unknown name is a TypeError, a
  * value outside its range a ValueError. */
 cocone::Parameters
-parseParameters(const char* function, const py::kwargs& kwargs)
+parseParameters(const char* function,
+                const py::kwargs& kwargs,
+                cocone::TilingOptions* tiling = nullptr)
 {
   cocone::Parameters p;
   for (const auto& item : kwargs) {
@@ -177,6 +180,18 @@ parseParameters(const char* function, const py::kwargs& kwargs)
     else if (name == "threads")
       p.threads = static_cast<unsigned int>(
           toInt(function, name, value, 0, ">= 0 (0: all processors)"));
+    else if (name == "tile_points" && tiling) {
+      const int points = toInt(function, name, value, 0, ">= 0 (0: one piece)");
+      requireValue(
+          points == 0 ||
+              static_cast<std::size_t>(points) >= cocone::MINIMUM_TILE_POINTS,
+          function,
+          name,
+          ("0 (one piece) or at least " + std::to_string(cocone::MINIMUM_TILE_POINTS))
+              .c_str(),
+          static_cast<double>(points));
+      tiling->tile_points = static_cast<std::size_t>(points);
+    }
     else
       throw py::type_error(std::string(function) +
                            "() got an unexpected keyword argument '" + name +
@@ -272,7 +287,7 @@ takeOutliers(R& result)
 }
 
 py::dict
-parametersDict(const cocone::Parameters& p)
+parametersDict(const cocone::Parameters& p, const cocone::TilingOptions& tiling = {})
 {
   py::dict d;
   d["ratio"] = p.ratio;
@@ -286,6 +301,7 @@ parametersDict(const cocone::Parameters& p)
   d["noise_threshold"] = p.noise_threshold;
   d["smoothing_iterations"] = p.smoothing_iterations;
   d["threads"] = p.threads;
+  d["tile_points"] = tiling.tile_points;
   return d;
 }
 
@@ -295,7 +311,9 @@ runPipeline(const char* function,
             const py::kwargs& kwargs,
             cocone::Stages stages)
 {
-  const cocone::Parameters parameters = parseParameters(function, kwargs);
+  cocone::TilingOptions tiling;
+  const cocone::Parameters parameters = parseParameters(
+      function, kwargs, stages == cocone::Stages::RECONSTRUCTION ? &tiling : nullptr);
   const py::array array = pointArray(function, points);
   const bool single = array.dtype().itemsize() == 4;
   const auto n = static_cast<std::size_t>(array.shape(0));
@@ -311,7 +329,8 @@ runPipeline(const char* function,
     std::vector<Eigen::Vector3d> xyz =
         single ? readPoints<float>(array) : readPoints<double>(array);
     const auto t1 = Clock::now();
-    r = cocone::run(std::move(xyz), parameters, stages);
+    r = tiling.tile_points > 0 ? cocone::runTiled(std::move(xyz), parameters, tiling)
+                               : cocone::run(std::move(xyz), parameters, stages);
     const auto t2 = Clock::now();
     input_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     run_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
@@ -406,7 +425,7 @@ runPipeline(const char* function,
   report["noise_after_smoothing"] = r.noise_after_smoothing;
   report["smoothed"] = r.smoothed;
   report["ratio"] = r.ratio; // the one used: the automatic one when ratio is 0
-  report["parameters"] = parametersDict(parameters);
+  report["parameters"] = parametersDict(parameters, tiling);
   report["timings_ms"] = timings;
   report["counts"] = counts;
   return out;
@@ -479,7 +498,9 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
       "noise_handling (outliers set aside, noisy clouds smoothed; default True), "
       "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
-      "that triangles of the local spacing close are closed; default True), threads. "
+      "that triangles of the local spacing close are closed; default True), threads, "
+      "tile_points (in tiles of at most this many points, stitched; default 0: one "
+      "piece). "
       "Runs without the GIL.");
   m.def(
       "detect_boundary",

@@ -215,7 +215,7 @@ def test_parameters_are_used():
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
                              "cocone_angle", "boundary_detection", "noise_handling",
                              "noise_threshold", "smoothing_iterations",
-                             "fill_undersampled_holes", "threads"}
+                             "fill_undersampled_holes", "threads", "tile_points"}
     assert defaults["noise_handling"] is True
     assert defaults["fill_undersampled_holes"] is True
     assert defaults["smoothing_iterations"] >= 1
@@ -226,6 +226,22 @@ def test_parameters_are_used():
     same = pcl_cocone.reconstruct(points, threads=np.int64(0), ratio=np.float32(0.0),
                                   boundary_detection=np.bool_(True), gap_angle=1)
     assert same.report["parameters"]["gap_angle"] == 1.0
+
+
+def test_tiles():
+    points = sphere(6000)
+    whole = pcl_cocone.reconstruct(points)
+    tiled = pcl_cocone.reconstruct(points, tile_points=1000)
+    check_mesh(tiled, len(points))
+    # Closed over the same points, both have 2N - 4 triangles.
+    assert tiled.border_loops == []
+    assert len(tiled.triangles) == len(whole.triangles)
+    assert tiled.report["parameters"]["tile_points"] == 1000
+    assert whole.report["parameters"]["tile_points"] == 0
+    with pytest.raises(ValueError, match="tile_points"):
+        pcl_cocone.reconstruct(points, tile_points=5)
+    with pytest.raises(TypeError, match="tile_points"):
+        pcl_cocone.detect_boundary(points, tile_points=1000)
 
 
 def test_outliers_far_from_a_sphere():
