@@ -28,6 +28,10 @@ struct LoopTriangle {
   std::array<int, 3> v;
 };
 
+/** Loops of at most this many edges whose Delaunay patch is not plausible are
+ * searched again over all triangles of their vertices (cubic in the edges). */
+constexpr std::size_t CUBIC_SEARCH_EDGES = 40;
+
 /** A patch from another mesh may hold at most this many triangles per loop edge:
  * a disk of a loop's k edges with i inner vertices has k + 2i - 2 triangles. */
 constexpr std::size_t PATCH_TRIANGLES_PER_EDGE = 16;
@@ -119,10 +123,25 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       const int a = hole[i], b = hole[j];
       return withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0;
     };
-    bool closed = patch.size() == k - 2;
-    for (const auto& t : patch)
-      closed = closed && plausible(t.v[0], t.v[1]) && plausible(t.v[1], t.v[2]) &&
-               plausible(t.v[0], t.v[2]);
+    const auto plausible_patch = [&]() {
+      bool ok = patch.size() == k - 2;
+      for (const auto& t : patch)
+        ok = ok && plausible(t.v[0], t.v[1]) && plausible(t.v[1], t.v[2]) &&
+             plausible(t.v[0], t.v[2]);
+      return ok;
+    };
+    bool closed = plausible_patch();
+    if (!closed && k <= CUBIC_SEARCH_EDGES) {
+      // The Delaunay faces of a loop round a corner or a crease may hold no short
+      // patch; all triangles of the loop's vertices may (Liepa's cubic search).
+      patch.clear();
+      CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
+          polyline,
+          third,
+          std::back_inserter(patch),
+          CGAL::parameters::use_delaunay_triangulation(false));
+      closed = plausible_patch();
+    }
     if (!closed) {
       open.push_back(std::move(loop));
       continue;
