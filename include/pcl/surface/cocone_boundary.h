@@ -268,11 +268,16 @@ public:
    * borders open (the question the paper leaves open).
    *
    * After the reconstruction every border loop of up to 1,000 edges is closed when
-   * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces finds a
-   * patch whose new edges are all at most 2.75 local spacings long: an undersampled
-   * hole has samples all around it that continue the surface at that spacing,
-   * where the sampled surface really ends nothing is that close across. No new
-   * vertex; the mesh stays an oriented manifold. getBoundaryPointIndices() is not
+   * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces (or,
+   * up to 40 edges, over all triangles of its points) finds a patch whose new edges
+   * are all at most 2.75 local spacings long: an undersampled hole has samples all
+   * around it that continue the surface at that spacing, where the sampled surface
+   * really ends nothing is that close across. A loop left, and points in no
+   * triangle, then get the original Co-cone's triangles there where those make a
+   * disk bounded by the loop or a closed surface, with edges as short (a part
+   * sampled too coarsely for the flatness test, such as a thin tube, which it flags
+   * all over). No new vertex; the mesh stays an oriented manifold.
+   * getBoundaryPointIndices() is not
    * changed by it (the paper's output); getBoundaryLoops() lists the loops left.
    * \param[in] enabled false: the holes left open, the mesh as without the step
    *            (default true)
