@@ -19,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include "caller_ids.h"
 #include "edge_sort.h"
 #include "stopwatch.h"
 
@@ -408,14 +409,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   }
   std::sort(result.boundary_indices.begin(), result.boundary_indices.end());
   std::sort(result.outlier_indices.begin(), result.outlier_indices.end());
-  result.polygons.reserve(result.triangles.size());
-  for (const auto& t : result.triangles)
-    result.polygons.push_back({result.representative[t[0]],
-                               result.representative[t[1]],
-                               result.representative[t[2]]});
-  for (auto& loop : result.border_loops)
-    for (auto& v : loop)
-      v = result.representative[v];
+  detail::meshToCallerIds(result);
   result.positions = std::move(dt.points); // the triangulation's last use
   return result;
 }

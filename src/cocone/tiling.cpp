@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "caller_ids.h"
 #include "edge_sort.h"
 #include "parallel.h"
 #include "stopwatch.h"
@@ -827,14 +828,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
       normal = -normal;
   }
 
-  result.polygons.reserve(triangles.size());
-  for (const auto& t : triangles)
-    result.polygons.push_back({result.representative[t[0]],
-                               result.representative[t[1]],
-                               result.representative[t[2]]});
-  for (auto& loop : result.border_loops)
-    for (auto& v : loop)
-      v = result.representative[v];
+  detail::meshToCallerIds(result);
   report.stitch_ms = clock.lap();
   result.timings.unique += report.cut_ms;
   result.timings.reconstruction += report.stitch_ms;
