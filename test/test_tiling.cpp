@@ -479,4 +479,162 @@ TEST(TilingClass, SetTilePoints)
   EXPECT_EQ(normals.size(), cloud->size());
 }
 
+/** The same bits (NaN equal to NaN). */
+template <typename T>
+bool
+sameBits(const std::vector<T>& a, const std::vector<T>& b)
+{
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+void
+expectSameResult(const Result& a, const Result& b)
+{
+  EXPECT_EQ(a.error, b.error);
+  EXPECT_EQ(a.polygons, b.polygons);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.border_loops, b.border_loops);
+  EXPECT_EQ(a.boundary_indices, b.boundary_indices);
+  EXPECT_EQ(a.outlier_indices, b.outlier_indices);
+  EXPECT_EQ(a.vertex_of_input, b.vertex_of_input);
+  EXPECT_EQ(a.representative, b.representative);
+  EXPECT_TRUE(sameBits(a.positions, b.positions));
+  EXPECT_TRUE(sameBits(a.normals, b.normals));
+  EXPECT_TRUE(sameBits(a.point_noise, b.point_noise));
+  EXPECT_EQ(a.offset, b.offset);
+  EXPECT_EQ(a.ratio, b.ratio);
+  EXPECT_EQ(a.noise_level, b.noise_level);
+}
+
+TEST(TilingPhases, ComposedByHandEqualRunTiled)
+{
+  // Caller ids not the positions, a few non-finite points and duplicates.
+  const Sample s = cocone_test::torus(options(20000, 0.1, 1.0, false));
+  std::vector<Eigen::Vector3d> points = s.points;
+  for (std::size_t i = 0; i < 30; ++i)
+    points.push_back(points[500 * i]);
+  points[7] = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<int> ids(points.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[i] = 3 * static_cast<int>(ids.size() - i) + 11;
+  Parameters parameters;
+  parameters.threads = 2;
+  TilingOptions tiling;
+  tiling.tile_points = TILE_POINTS;
+  TilingReport whole_report;
+  const Result whole =
+      pcl::cocone::runTiled(points, parameters, tiling, ids, &whole_report);
+  ASSERT_TRUE(whole.error.empty()) << whole.error;
+
+  const pcl::cocone::TilePlan plan =
+      pcl::cocone::planTiles(points, parameters, tiling, ids);
+  ASSERT_TRUE(plan.error.empty()) << plan.error;
+  EXPECT_FALSE(plan.one_piece);
+  ASSERT_EQ(plan.tiles(), whole_report.tiles);
+  EXPECT_EQ(plan.point_tile, whole_report.point_tile);
+  // The cores partition the finite points; a tile's points start with its core.
+  std::vector<int> in_core(points.size(), 0);
+  for (std::size_t t = 0; t < plan.tiles(); ++t) {
+    const std::vector<int> members = plan.tilePoints(t);
+    ASSERT_EQ(members.size(), plan.coreSize(t) + plan.halo[t].size());
+    for (std::size_t i = 0; i < members.size(); ++i)
+      EXPECT_EQ(plan.point_tile[members[i]] == static_cast<int>(t),
+                i < plan.coreSize(t));
+    for (std::size_t i = 0; i < plan.coreSize(t); ++i)
+      ++in_core[members[i]];
+  }
+  for (std::size_t p = 0; p < points.size(); ++p)
+    EXPECT_EQ(in_core[p], points[p].allFinite() ? 1 : 0) << p;
+
+  // The tiles in reverse order, on one thread each, half of them from their own
+  // points (as a remote worker has them): the same result.
+  std::vector<pcl::cocone::TileResult> results(plan.tiles());
+  Parameters one_thread = parameters;
+  one_thread.threads = 1;
+  for (std::size_t t = plan.tiles(); t-- > 0;) {
+    if (t % 2 == 0) {
+      results[t] = pcl::cocone::reconstructTile(plan, t, points, one_thread, ids);
+      continue;
+    }
+    std::vector<Eigen::Vector3d> local;
+    std::vector<int> local_ids;
+    for (const int p : plan.tilePoints(t)) {
+      local.push_back(points[p]);
+      local_ids.push_back(ids[p]);
+    }
+    results[t] = pcl::cocone::reconstructTile(
+        std::move(local), local_ids, plan.coreSize(t), one_thread);
+  }
+  for (const auto& r : results)
+    ASSERT_TRUE(r.error.empty()) << r.error;
+  TilingReport report;
+  const Result stitched =
+      pcl::cocone::stitchTiles(plan, results, parameters, ids, &report);
+  expectSameResult(stitched, whole);
+  EXPECT_EQ(report.point_tile, whole_report.point_tile);
+  EXPECT_EQ(report.triangle_tile, whole_report.triangle_tile);
+  EXPECT_EQ(report.halo_points, whole_report.halo_points);
+  EXPECT_EQ(report.patches, whole_report.patches);
+  EXPECT_EQ(report.patches_flipped, whole_report.patches_flipped);
+  EXPECT_EQ(report.seam_filled, whole_report.seam_filled);
+}
+
+TEST(TilingPhases, ResultsThatDoNotFitThePlanGiveAnError)
+{
+  const Sample s = cocone_test::sphere(options(6000));
+  Parameters parameters;
+  parameters.threads = 1;
+  TilingOptions tiling;
+  tiling.tile_points = 2000;
+  const pcl::cocone::TilePlan plan =
+      pcl::cocone::planTiles(s.points, parameters, tiling);
+  ASSERT_TRUE(plan.error.empty()) << plan.error;
+  ASSERT_GE(plan.tiles(), 2u);
+  std::vector<pcl::cocone::TileResult> results;
+  for (std::size_t t = 0; t < plan.tiles(); ++t)
+    results.push_back(pcl::cocone::reconstructTile(plan, t, s.points, parameters));
+  ASSERT_TRUE(pcl::cocone::stitchTiles(plan, results, parameters).error.empty());
+
+  const auto fails = [&](std::vector<pcl::cocone::TileResult> r) {
+    return pcl::cocone::stitchTiles(plan, std::move(r), parameters).error;
+  };
+  EXPECT_NE(fails({results.begin(), results.end() - 1}), ""); // one missing
+  auto broken = results;
+  broken[1].error = "worker lost";
+  EXPECT_EQ(fails(broken), "tile 1: worker lost");
+  broken = results;
+  broken[0].representative.pop_back();
+  EXPECT_NE(fails(broken), "");
+  broken = results;
+  broken[1].kept.push_back({0, 1, 100000}); // an id of no point
+  EXPECT_NE(fails(broken), "");
+  std::swap(broken[0], broken[1]); // the tiles' order matters
+  EXPECT_NE(fails(broken), "");
+  EXPECT_NE(pcl::cocone::stitchTiles(plan, results, parameters, {1, 2}).error, "");
+
+  // A tile's own points: checked, never thrown.
+  const std::vector<Eigen::Vector3d> some(s.points.begin(), s.points.begin() + 100);
+  std::vector<int> ids(100);
+  for (int i = 0; i < 100; ++i)
+    ids[i] = i;
+  EXPECT_NE(pcl::cocone::reconstructTile(some, {1, 2}, 50, parameters).error, "");
+  EXPECT_NE(pcl::cocone::reconstructTile(some, ids, 101, parameters).error, "");
+  auto twice = ids;
+  twice[5] = 4;
+  EXPECT_NE(pcl::cocone::reconstructTile(some, twice, 50, parameters).error, "");
+  auto nan = some;
+  nan[3].x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(pcl::cocone::reconstructTile(nan, ids, 50, parameters).error, "");
+  EXPECT_NE(
+      pcl::cocone::reconstructTile(plan, plan.tiles(), s.points, parameters).error, "");
+  // A bad option fails the plan, and so whatever is made of it.
+  tiling.tile_points = 10;
+  const pcl::cocone::TilePlan bad =
+      pcl::cocone::planTiles(s.points, parameters, tiling);
+  EXPECT_NE(bad.error, "");
+  EXPECT_NE(pcl::cocone::reconstructTile(bad, 0, s.points, parameters).error, "");
+  EXPECT_NE(pcl::cocone::stitchTiles(bad, results, parameters).error, "");
+}
+
 } // namespace

@@ -41,11 +41,13 @@ constexpr std::size_t SPACING_SAMPLES = 512;
 /** The position in the points of each caller id. */
 class IdIndex {
 public:
-  /** False (with \a error) if the ids are not distinct. */
+  /** False (with \a error) if the ids are not distinct. \a count: the number of
+   * points, which are their own ids when \a ids is empty. */
   bool
-  build(const std::vector<int>& ids, std::string& error)
+  build(const std::vector<int>& ids, std::size_t count, std::string& error)
   {
     ids_ = &ids;
+    count_ = count;
     if (ids.empty())
       return true;
     const auto [lo, hi] = std::minmax_element(ids.begin(), ids.end());
@@ -97,8 +99,27 @@ public:
     return it->second;
   }
 
+  /** Whether \a id is one of the ids. */
+  bool
+  contains(int id) const
+  {
+    if (ids_->empty())
+      return id >= 0 && static_cast<std::size_t>(id) < count_;
+    if (!dense_.empty()) {
+      const std::int64_t k = static_cast<std::int64_t>(id) - low_;
+      return k >= 0 && static_cast<std::size_t>(k) < dense_.size() &&
+             dense_[static_cast<std::size_t>(k)] >= 0;
+    }
+    const auto it =
+        std::lower_bound(sorted_.begin(),
+                         sorted_.end(),
+                         std::make_pair(id, std::numeric_limits<int>::min()));
+    return it != sorted_.end() && it->first == id;
+  }
+
 private:
   const std::vector<int>* ids_ = nullptr;
+  std::size_t count_ = 0;
   int low_ = 0;
   std::vector<int> dense_;
   std::vector<std::pair<int, int>> sorted_;
@@ -165,6 +186,13 @@ public:
   order() const
   {
     return order_;
+  }
+
+  /** The order, moved out: the tiles are of no further use. */
+  std::vector<int>
+  takeOrder()
+  {
+    return std::move(order_);
   }
 
   /** The positions of the points not in \a tile's core within \a reach of its box,
@@ -320,36 +348,6 @@ medianSpacing(const std::vector<Eigen::Vector3d>& P,
   return 0.0;
 }
 
-/** What one tile leaves for the stitch: the labels of its core, the triangles it
- * keeps and the others of its mesh. */
-struct TileOutput {
-  /** A failure that fails the run (no memory, no thread). */
-  std::string error;
-  /** Why the tile's points give no mesh (run()'s error); empty if they do. */
-  std::string degenerate;
-  std::size_t points = 0; ///< core and halo
-  /** Per core point, in the order of the core: the caller id of its vertex's
-   * representative, -2 for an outlier. */
-  std::vector<int> representative;
-  /** Per core point: bit 0 boundary, bit 1 umbrella failure. */
-  std::vector<std::uint8_t> flags;
-  /** Per core point its noise level; empty without noise handling. */
-  std::vector<float> noise;
-  /** Per core point that represents its vertex, in the order of the core: the
-   * position (in the caller's frame) and the normal. */
-  std::vector<Eigen::Vector3d> position, normal;
-  /** Kept triangles, oriented, over caller ids. */
-  std::vector<Triangle> kept;
-  /** The tile's other triangles (of the halo), ids ascending: they may close a seam
-   * hole where the tiles that own them disagree. */
-  std::vector<Triangle> seen;
-  double ratio = 0.0;
-  double noise_after_smoothing = 0.0;
-  bool smoothed = false;
-  ReconstructionCounts counts;
-  Timings timings;
-};
-
 void
 add(ReconstructionCounts& a, const ReconstructionCounts& b)
 {
@@ -391,99 +389,6 @@ median(std::vector<double> v)
   return *m;
 }
 
-/** Reconstruct tile \a t: run() on its core and halo, then what the stitch needs. */
-TileOutput
-reconstructTile(std::size_t t,
-                const std::vector<Eigen::Vector3d>& points,
-                const Tiles& tiles,
-                const IdIndex& ids,
-                const std::vector<int>& point_tile,
-                const Parameters& parameters,
-                double halo_spacings)
-{
-  TileOutput out;
-  const auto& core = tiles.core(t);
-  const int* core_index = tiles.order().data() + core.begin;
-  const std::size_t core_size = core.end - core.begin;
-  const double reach =
-      halo_spacings * medianSpacing(points, core_index, core_size, core.box);
-  std::vector<int> members(core_index, core_index + core_size);
-  {
-    const std::vector<int> halo = tiles.halo(t, reach);
-    members.insert(members.end(), halo.begin(), halo.end());
-  }
-  out.points = members.size();
-  std::vector<Eigen::Vector3d> local;
-  std::vector<int> local_ids;
-  local.reserve(members.size());
-  local_ids.reserve(members.size());
-  for (const int p : members) {
-    local.push_back(points[p]);
-    local_ids.push_back(ids.id(static_cast<std::size_t>(p)));
-  }
-  std::vector<int>().swap(members);
-  Result r = run(std::move(local), parameters, Stages::RECONSTRUCTION, local_ids);
-  if (!r.error.empty() && r.vertex_of_input.size() != local_ids.size()) {
-    out.error = r.error; // out of memory, no thread: nothing to go on with
-    return out;
-  }
-  out.degenerate = r.error;
-  out.ratio = r.ratio;
-  out.noise_after_smoothing = r.noise_after_smoothing;
-  out.smoothed = r.smoothed;
-  out.counts = r.counts;
-  out.timings = r.timings;
-
-  // The representative of each vertex: its lowest caller id, as run() chooses.
-  std::vector<int> representative(r.vertices, std::numeric_limits<int>::max());
-  for (std::size_t i = 0; i < local_ids.size(); ++i)
-    if (r.vertex_of_input[i] >= 0)
-      representative[r.vertex_of_input[i]] =
-          std::min(representative[r.vertex_of_input[i]], local_ids[i]);
-  out.representative.resize(core_size);
-  out.flags.resize(core_size);
-  const bool noise = r.point_noise.size() == local_ids.size();
-  if (noise)
-    out.noise.assign(r.point_noise.begin(), r.point_noise.begin() + core_size);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t i = 0; i < core_size; ++i) {
-    const int v = r.vertex_of_input[i];
-    if (v < 0) {
-      out.representative[i] = -2; // finite, so an outlier
-      continue;
-    }
-    out.representative[i] = representative[v];
-    out.flags[i] = !out.degenerate.empty()
-                       ? 1
-                       : static_cast<std::uint8_t>((r.boundary[v] ? 1 : 0) |
-                                                   (r.umbrella_failed[v] ? 2 : 0));
-    if (representative[v] != local_ids[i])
-      continue;
-    if (!out.degenerate.empty()) {
-      out.position.push_back(points[core_index[i]]);
-      out.normal.push_back(Eigen::Vector3d::Constant(nan));
-      continue;
-    }
-    out.position.push_back(r.positions[v] + r.offset);
-    out.normal.push_back(r.normals[v]);
-  }
-
-  // The ownership rule: the tile whose core holds the lowest id keeps the triangle.
-  const auto tile_of = [&](int id) { return point_tile[ids.position(id)]; };
-  const auto own = static_cast<int>(t);
-  for (const Triangle& tri : r.polygons) {
-    const int lowest = std::min({tri[0], tri[1], tri[2]});
-    if (tile_of(lowest) == own)
-      out.kept.push_back(tri);
-    else {
-      Triangle sorted = tri;
-      std::sort(sorted.begin(), sorted.end());
-      out.seen.push_back(sorted);
-    }
-  }
-  return out;
-}
-
 /** Run \a body(t) for t in [0, count) on up to \a workers threads, each tile on one
  * of them, the next tile to the first thread free. */
 template <typename Body>
@@ -515,63 +420,25 @@ forEachTile(std::size_t count, int workers, const Body& body)
     thread.join();
 }
 
+/** The stitch of stitchTiles(), on checked input. */
 Result
-stitchTiles(std::vector<Eigen::Vector3d>&& points,
-            const Parameters& parameters,
-            const TilingOptions& tiling,
-            const IdIndex& ids,
-            TilingReport& report)
+stitch(TilePlan& plan,
+       std::vector<TileResult>& outputs,
+       const Parameters& parameters,
+       const IdIndex& ids,
+       TilingReport& report)
 {
   Result result;
   detail::Stopwatch clock;
-  const std::size_t n = points.size();
+  const std::size_t n = plan.points;
+  const std::size_t count = plan.tiles();
   const int threads = resolveThreads(parameters.threads);
   result.vertex_of_input.assign(n, -1);
-  std::vector<int> finite;
-  Box all;
-  for (std::size_t i = 0; i < n; ++i)
-    if (points[i].allFinite()) {
-      finite.push_back(static_cast<int>(i));
-      all.extend(points[i]);
-    }
-  const Tiles tiles(points, std::move(finite), tiling.tile_points);
-  const std::size_t count = tiles.size();
   report.tiles = count;
-  report.point_tile.assign(n, -1);
-  for (std::size_t t = 0; t < count; ++t)
-    for (std::size_t i = tiles.core(t).begin; i < tiles.core(t).end; ++i)
-      report.point_tile[tiles.order()[i]] = static_cast<int>(t);
-  const std::vector<int>& point_tile = report.point_tile;
-  report.cut_ms = clock.lap();
-
-  // The tiles, a few at a time: each holds its triangulation while it runs.
-  const int in_flight = static_cast<int>(std::min<std::size_t>(
-      tiling.tiles_in_flight > 0 ? tiling.tiles_in_flight : threads, count));
-  Parameters tile_parameters = parameters;
-  tile_parameters.threads = static_cast<unsigned>(std::max(1, threads / in_flight));
-  std::vector<TileOutput> outputs(count);
-  forEachTile(count, in_flight, [&](std::size_t t) {
-    try {
-      outputs[t] = reconstructTile(
-          t, points, tiles, ids, point_tile, tile_parameters, tiling.halo_spacings);
-    }
-    catch (const std::bad_alloc&) {
-      outputs[t] = TileOutput();
-      outputs[t].error = "out of memory";
-    }
-    catch (const std::exception& e) { // must not leave the thread
-      outputs[t] = TileOutput();
-      outputs[t].error = e.what();
-    }
-  });
-  report.tiles_ms = clock.lap();
-  for (std::size_t t = 0; t < count; ++t)
-    if (!outputs[t].error.empty()) {
-      result.error = "tile " + std::to_string(t) + ": " + outputs[t].error;
-      return result;
-    }
+  report.cut_ms = plan.cut_ms;
+  std::vector<std::vector<int>>().swap(plan.halo);
   // No tile with a mesh: as run() on the whole would, no result.
-  if (std::all_of(outputs.begin(), outputs.end(), [](const TileOutput& o) {
+  if (std::all_of(outputs.begin(), outputs.end(), [](const TileResult& o) {
         return !o.degenerate.empty();
       })) {
     result.error = outputs[0].degenerate;
@@ -589,11 +456,11 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     result.point_noise.assign(n, std::numeric_limits<float>::quiet_NaN());
   std::vector<double> ratios, after;
   for (std::size_t t = 0; t < count; ++t) {
-    TileOutput& o = outputs[t];
-    const auto& core = tiles.core(t);
+    TileResult& o = outputs[t];
+    const std::size_t core_size = plan.coreSize(t);
     int k = 0;
-    for (std::size_t i = 0; i < core.end - core.begin; ++i) {
-      const int p = tiles.order()[core.begin + i];
+    for (std::size_t i = 0; i < core_size; ++i) {
+      const int p = plan.order[plan.core_begin[t] + i];
       representative_of[p] = o.representative[i];
       flags[p] = o.flags[i];
       if (o.representative[i] == ids.id(static_cast<std::size_t>(p)))
@@ -604,7 +471,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     std::vector<int>().swap(o.representative);
     std::vector<std::uint8_t>().swap(o.flags);
     std::vector<float>().swap(o.noise);
-    report.halo_points += o.points - (core.end - core.begin);
+    report.halo_points += o.points - core_size;
     report.largest_tile = std::max(report.largest_tile, o.points);
     report.degenerate_tiles += !o.degenerate.empty();
     if (o.degenerate.empty())
@@ -624,11 +491,11 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
         levels.push_back(l);
     result.noise_level = median(levels);
   }
-  result.offset = 0.5 * (all.lo + all.hi);
+  result.offset = plan.offset;
   std::vector<int> vertex_tile;
   for (std::size_t p = 0; p < n; ++p)
     if (slot[p] >= 0) {
-      const auto& o = outputs[point_tile[p]];
+      const auto& o = outputs[plan.point_tile[p]];
       result.representative.push_back(ids.id(p));
       result.positions.push_back(o.position[slot[p]] - result.offset);
       result.normals.push_back(o.normal[slot[p]]);
@@ -659,7 +526,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
   std::vector<int>().swap(representative_of);
   std::vector<int>().swap(slot);
   std::vector<std::uint8_t>().swap(flags);
-  std::vector<Eigen::Vector3d>().swap(points);
+  std::vector<int>().swap(plan.order);
 
   // The kept triangles over vertex ids; their patches; the tiles' other triangles.
   const auto vertex = [&](int id) { return result.vertex_of_input[ids.position(id)]; };
@@ -668,7 +535,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
   std::vector<Triangle> seen;
   std::size_t patches = 0;
   for (std::size_t t = 0; t < count; ++t) {
-    TileOutput& o = outputs[t];
+    TileResult& o = outputs[t];
     std::vector<Triangle> mine;
     mine.reserve(o.kept.size());
     for (const Triangle& tri : o.kept) {
@@ -695,7 +562,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     }
     std::vector<Triangle>().swap(o.seen);
   }
-  std::vector<TileOutput>().swap(outputs);
+  std::vector<TileResult>().swap(outputs);
   report.patches = patches;
 
   // Patches turned over to agree with their neighbours: per pair of patches the
@@ -773,7 +640,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
     return e >= 0 && incidences.count(static_cast<std::size_t>(e)) == 1;
   };
   const auto core_of = [&](int v) {
-    return point_tile[ids.position(result.representative[v])];
+    return plan.point_tile[ids.position(result.representative[v])];
   };
   report.seam_filled = fillHoles(
       result.positions,
@@ -828,6 +695,7 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
       normal = -normal;
   }
 
+  report.point_tile = std::move(plan.point_tile);
   detail::meshToCallerIds(result);
   report.stitch_ms = clock.lap();
   result.timings.unique += report.cut_ms;
@@ -836,6 +704,330 @@ stitchTiles(std::vector<Eigen::Vector3d>&& points,
 }
 
 } // namespace
+
+std::vector<int>
+TilePlan::tilePoints(std::size_t tile) const
+{
+  std::vector<int> members(
+      order.begin() + static_cast<std::ptrdiff_t>(core_begin[tile]),
+      order.begin() + static_cast<std::ptrdiff_t>(core_begin[tile + 1]));
+  members.insert(members.end(), halo[tile].begin(), halo[tile].end());
+  return members;
+}
+
+TilePlan
+planTiles(const std::vector<Eigen::Vector3d>& points,
+          const Parameters& parameters,
+          const TilingOptions& tiling,
+          const std::vector<int>& ids)
+{
+  TilePlan plan;
+  detail::Stopwatch clock;
+  const std::size_t n = points.size();
+  plan.points = n;
+  if (!ids.empty() && ids.size() != n) {
+    plan.error = "ids has " + std::to_string(ids.size()) + " entries for " +
+                 std::to_string(n) + " points";
+    return plan;
+  }
+  if (tiling.tile_points > 0 && tiling.tile_points < MINIMUM_TILE_POINTS) {
+    plan.error = "tile_points must be 0 (one piece) or at least " +
+                 std::to_string(MINIMUM_TILE_POINTS) + " (got " +
+                 std::to_string(tiling.tile_points) + ")";
+    return plan;
+  }
+  if (!(tiling.halo_spacings >= 0.0) || !std::isfinite(tiling.halo_spacings)) {
+    plan.error = "halo_spacings must be finite and >= 0";
+    return plan;
+  }
+  try {
+    IdIndex index;
+    if (!index.build(ids, n, plan.error))
+      return plan;
+    std::vector<int> finite;
+    Box all;
+    for (std::size_t i = 0; i < n; ++i)
+      if (points[i].allFinite()) {
+        finite.push_back(static_cast<int>(i));
+        all.extend(points[i]);
+      }
+    if (!finite.empty())
+      plan.offset = 0.5 * (all.lo + all.hi);
+    plan.point_tile.assign(n, -1);
+    if (tiling.tile_points == 0 || finite.size() <= tiling.tile_points) {
+      plan.one_piece = true;
+      for (const int p : finite)
+        plan.point_tile[p] = 0;
+      plan.core_begin = {0, finite.size()};
+      plan.order = std::move(finite);
+      plan.halo.resize(1);
+      plan.cut_ms = clock.lap();
+      return plan;
+    }
+    Tiles tiles(points, std::move(finite), tiling.tile_points);
+    const std::size_t count = tiles.size();
+    plan.core_begin.resize(count + 1);
+    for (std::size_t t = 0; t < count; ++t) {
+      plan.core_begin[t] = tiles.core(t).begin;
+      for (std::size_t i = tiles.core(t).begin; i < tiles.core(t).end; ++i)
+        plan.point_tile[tiles.order()[i]] = static_cast<int>(t);
+    }
+    plan.core_begin[count] = tiles.order().size();
+    // The halo of each tile: the points within its reach, which is measured on its
+    // own core's spacing.
+    plan.halo.resize(count);
+    std::atomic<bool> out_of_memory{false};
+    const int threads = resolveThreads(parameters.threads);
+    forEachTile(count,
+                static_cast<int>(std::min<std::size_t>(threads, count)),
+                [&](std::size_t t) {
+                  try {
+                    const auto& core = tiles.core(t);
+                    const double reach =
+                        tiling.halo_spacings *
+                        medianSpacing(points,
+                                      tiles.order().data() + core.begin,
+                                      core.end - core.begin,
+                                      core.box);
+                    plan.halo[t] = tiles.halo(t, reach);
+                  }
+                  catch (const std::bad_alloc&) { // must not leave the thread
+                    out_of_memory = true;
+                  }
+                });
+    if (out_of_memory)
+      throw std::bad_alloc();
+    plan.order = tiles.takeOrder();
+    plan.cut_ms = clock.lap();
+  }
+  catch (const std::bad_alloc&) {
+    plan = TilePlan();
+    plan.points = n;
+    plan.error = "out of memory for " + std::to_string(n) + " points";
+  }
+  catch (const std::system_error& e) { // no thread could be started
+    plan = TilePlan();
+    plan.points = n;
+    plan.error = std::string("system error: ") + e.what();
+  }
+  return plan;
+}
+
+TileResult
+reconstructTile(const TilePlan& plan,
+                std::size_t tile,
+                const std::vector<Eigen::Vector3d>& points,
+                const Parameters& parameters,
+                const std::vector<int>& ids)
+{
+  TileResult out;
+  if (!plan.error.empty())
+    out.error = "the plan failed: " + plan.error;
+  else if (tile >= plan.tiles())
+    out.error = "no tile " + std::to_string(tile) + " in a plan of " +
+                std::to_string(plan.tiles());
+  else if (points.size() != plan.points || (!ids.empty() && ids.size() != plan.points))
+    out.error = "the points or ids are not those of the plan";
+  if (!out.error.empty())
+    return out;
+  try {
+    std::vector<Eigen::Vector3d> local;
+    std::vector<int> local_ids;
+    {
+      const std::vector<int> members = plan.tilePoints(tile);
+      local.reserve(members.size());
+      local_ids.reserve(members.size());
+      for (const int p : members) {
+        local.push_back(points[p]);
+        local_ids.push_back(ids.empty() ? p : ids[p]);
+      }
+    }
+    return reconstructTile(
+        std::move(local), local_ids, plan.coreSize(tile), parameters);
+  }
+  catch (const std::bad_alloc&) {
+    out.error = "out of memory";
+  }
+  return out;
+}
+
+TileResult
+reconstructTile(std::vector<Eigen::Vector3d> points,
+                const std::vector<int>& ids,
+                std::size_t core_points,
+                const Parameters& parameters)
+{
+  TileResult out;
+  try {
+    if (ids.size() != points.size()) {
+      out.error = "ids has " + std::to_string(ids.size()) + " entries for " +
+                  std::to_string(points.size()) + " points";
+      return out;
+    }
+    if (core_points > points.size()) {
+      out.error = "core_points " + std::to_string(core_points) + " of " +
+                  std::to_string(points.size()) + " points";
+      return out;
+    }
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (!points[i].allFinite()) {
+        out.error = "tile point " + std::to_string(i) + " is not finite";
+        return out;
+      }
+    IdIndex index;
+    if (!index.build(ids, points.size(), out.error))
+      return out;
+    out.points = points.size();
+    // What the stitch needs of the core: a degenerate tile's positions are its own,
+    // and the ownership rule asks whether a triangle's lowest id is in the core.
+    const std::vector<Eigen::Vector3d> core_positions(
+        points.begin(), points.begin() + static_cast<std::ptrdiff_t>(core_points));
+    std::vector<int> core_ids(ids.begin(),
+                              ids.begin() + static_cast<std::ptrdiff_t>(core_points));
+    std::sort(core_ids.begin(), core_ids.end());
+
+    Result r = run(std::move(points), parameters, Stages::RECONSTRUCTION, ids);
+    if (!r.error.empty() && r.vertex_of_input.size() != ids.size()) {
+      out.error = r.error; // out of memory, no thread: nothing to go on with
+      return out;
+    }
+    out.degenerate = r.error;
+    out.ratio = r.ratio;
+    out.noise_after_smoothing = r.noise_after_smoothing;
+    out.smoothed = r.smoothed;
+    out.counts = r.counts;
+    out.timings = r.timings;
+
+    // The representative of each vertex: its lowest caller id, as run() chooses.
+    std::vector<int> representative(r.vertices, std::numeric_limits<int>::max());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (r.vertex_of_input[i] >= 0)
+        representative[r.vertex_of_input[i]] =
+            std::min(representative[r.vertex_of_input[i]], ids[i]);
+    out.representative.resize(core_points);
+    out.flags.resize(core_points);
+    const bool noise = r.point_noise.size() == ids.size();
+    if (noise)
+      out.noise.assign(r.point_noise.begin(),
+                       r.point_noise.begin() +
+                           static_cast<std::ptrdiff_t>(core_points));
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t i = 0; i < core_points; ++i) {
+      const int v = r.vertex_of_input[i];
+      if (v < 0) {
+        out.representative[i] = -2; // finite, so an outlier
+        continue;
+      }
+      out.representative[i] = representative[v];
+      out.flags[i] = !out.degenerate.empty()
+                         ? 1
+                         : static_cast<std::uint8_t>((r.boundary[v] ? 1 : 0) |
+                                                     (r.umbrella_failed[v] ? 2 : 0));
+      if (representative[v] != ids[i])
+        continue;
+      if (!out.degenerate.empty()) {
+        out.position.push_back(core_positions[i]);
+        out.normal.push_back(Eigen::Vector3d::Constant(nan));
+        continue;
+      }
+      out.position.push_back(r.positions[v] + r.offset);
+      out.normal.push_back(r.normals[v]);
+    }
+
+    // The ownership rule: the tile whose core holds the lowest id keeps the triangle.
+    for (const Triangle& tri : r.polygons) {
+      const int lowest = std::min({tri[0], tri[1], tri[2]});
+      if (std::binary_search(core_ids.begin(), core_ids.end(), lowest))
+        out.kept.push_back(tri);
+      else {
+        Triangle sorted = tri;
+        std::sort(sorted.begin(), sorted.end());
+        out.seen.push_back(sorted);
+      }
+    }
+  }
+  catch (const std::bad_alloc&) {
+    out = TileResult();
+    out.error = "out of memory";
+  }
+  catch (const std::exception& e) {
+    out = TileResult();
+    out.error = e.what();
+  }
+  return out;
+}
+
+Result
+stitchTiles(TilePlan plan,
+            std::vector<TileResult> results,
+            const Parameters& parameters,
+            const std::vector<int>& ids,
+            TilingReport* report)
+{
+  TilingReport local;
+  TilingReport& rep = report ? *report : local;
+  rep = TilingReport();
+  Result failed;
+  const std::size_t count = plan.tiles();
+  if (!plan.error.empty()) {
+    failed.error = "the plan failed: " + plan.error;
+    return failed;
+  }
+  if (count == 0 || results.size() != count) {
+    failed.error = std::to_string(results.size()) + " tile results for a plan of " +
+                   std::to_string(count) + " tiles";
+    return failed;
+  }
+  if (!ids.empty() && ids.size() != plan.points) {
+    failed.error = "ids has " + std::to_string(ids.size()) + " entries for " +
+                   std::to_string(plan.points) + " points";
+    return failed;
+  }
+  for (std::size_t t = 0; t < count; ++t)
+    if (!results[t].error.empty()) {
+      failed.error = "tile " + std::to_string(t) + ": " + results[t].error;
+      return failed;
+    }
+  try {
+    IdIndex index;
+    if (!index.build(ids, plan.points, failed.error))
+      return failed;
+    // Results from elsewhere are checked against the plan: a wrong one is an error,
+    // not a crash.
+    for (std::size_t t = 0; t < count; ++t) {
+      const TileResult& o = results[t];
+      const std::size_t core = plan.coreSize(t);
+      std::size_t representatives = 0;
+      bool fits = o.representative.size() == core && o.flags.size() == core &&
+                  (o.noise.empty() || o.noise.size() == core);
+      for (std::size_t i = 0; fits && i < core; ++i) {
+        const int rep_id = o.representative[i];
+        fits = rep_id == -2 || index.contains(rep_id);
+        representatives += rep_id == index.id(plan.order[plan.core_begin[t] + i]);
+      }
+      fits = fits && o.position.size() == representatives &&
+             o.normal.size() == representatives;
+      for (const auto* list : {&o.kept, &o.seen})
+        for (std::size_t i = 0; fits && i < list->size(); ++i)
+          for (const int id : (*list)[i])
+            fits = fits && index.contains(id);
+      if (!fits) {
+        failed.error = "the result of tile " + std::to_string(t) +
+                       " does not fit the plan (made from other points or ids?)";
+        return failed;
+      }
+    }
+    return stitch(plan, results, parameters, index, rep);
+  }
+  catch (const std::bad_alloc&) {
+    failed.error = "out of memory for " + std::to_string(plan.points) + " points";
+  }
+  catch (const std::system_error& e) { // no thread could be started
+    failed.error = std::string("system error: ") + e.what();
+  }
+  rep = TilingReport();
+  return failed;
+}
 
 Result
 runTiled(std::vector<Eigen::Vector3d> points,
@@ -848,44 +1040,41 @@ runTiled(std::vector<Eigen::Vector3d> points,
   TilingReport& rep = report ? *report : local;
   rep = TilingReport();
   Result failed;
-  if (!ids.empty() && ids.size() != points.size()) {
-    failed.error = "ids has " + std::to_string(ids.size()) + " entries for " +
-                   std::to_string(points.size()) + " points";
+  TilePlan plan = planTiles(points, parameters, tiling, ids);
+  if (!plan.error.empty()) {
+    failed.error = plan.error;
     return failed;
   }
-  if (tiling.tile_points > 0 && tiling.tile_points < MINIMUM_TILE_POINTS) {
-    failed.error = "tile_points must be 0 (one piece) or at least " +
-                   std::to_string(MINIMUM_TILE_POINTS) + " (got " +
-                   std::to_string(tiling.tile_points) + ")";
-    return failed;
-  }
-  if (!(tiling.halo_spacings >= 0.0) || !std::isfinite(tiling.halo_spacings)) {
-    failed.error = "halo_spacings must be finite and >= 0";
-    return failed;
-  }
-  const std::size_t count = points.size();
+  const std::size_t count = plan.tiles(), n = points.size();
   try {
-    IdIndex index;
-    if (!index.build(ids, failed.error))
-      return failed;
-    std::size_t finite = 0;
-    for (const auto& p : points)
-      finite += p.allFinite();
-    if (tiling.tile_points == 0 || finite <= tiling.tile_points) {
-      std::vector<int> tile(count, -1);
-      for (std::size_t i = 0; i < count; ++i)
-        tile[i] = points[i].allFinite() ? 0 : -1;
+    if (plan.one_piece) {
       Result r = run(std::move(points), parameters, Stages::RECONSTRUCTION, ids);
       rep.tiles = 1;
-      rep.largest_tile = finite;
-      rep.point_tile = std::move(tile);
+      rep.largest_tile = plan.order.size();
+      rep.point_tile = std::move(plan.point_tile);
       rep.triangle_tile.assign(r.polygons.size(), 0);
       return r;
     }
-    return stitchTiles(std::move(points), parameters, tiling, index, rep);
+    // The tiles, a few at a time: each holds its triangulation while it runs.
+    detail::Stopwatch clock;
+    const int threads = resolveThreads(parameters.threads);
+    const int in_flight = static_cast<int>(std::min<std::size_t>(
+        tiling.tiles_in_flight > 0 ? tiling.tiles_in_flight : threads, count));
+    Parameters tile_parameters = parameters;
+    tile_parameters.threads = static_cast<unsigned>(std::max(1, threads / in_flight));
+    std::vector<TileResult> results(count);
+    forEachTile(count, in_flight, [&](std::size_t t) {
+      results[t] = reconstructTile(plan, t, points, tile_parameters, ids);
+    });
+    const double tiles_ms = clock.lap();
+    std::vector<Eigen::Vector3d>().swap(points);
+    Result r = stitchTiles(std::move(plan), std::move(results), parameters, ids, &rep);
+    if (r.error.empty())
+      rep.tiles_ms = tiles_ms;
+    return r;
   }
   catch (const std::bad_alloc&) {
-    failed.error = "out of memory for " + std::to_string(count) + " points";
+    failed.error = "out of memory for " + std::to_string(n) + " points";
   }
   catch (const std::system_error& e) { // no thread could be started
     failed.error = std::string("system error: ") + e.what();

@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace pcl {
@@ -64,7 +66,8 @@ struct TilingReport {
   RepairCounts stitch;
   /** Triangles added to close seam holes, from the tiles' own meshes. */
   std::size_t seam_filled = 0;
-  /** Wall-clock time of cutting the cloud into tiles, in milliseconds. */
+  /** Wall-clock time of cutting the cloud into tiles and finding their halos
+   * (planTiles()), in milliseconds. */
   double cut_ms = 0.0;
   /** Wall-clock time of reconstructing the tiles, in milliseconds. */
   double tiles_ms = 0.0;
@@ -75,6 +78,172 @@ struct TilingReport {
   std::size_t degenerate_tiles = 0;
 };
 
+/** \brief How a cloud is cut into tiles: the first phase of runTiled().
+ *
+ * Plain data: the cores and halos are positions in the planned points, so that the
+ * tiles can be handed to other threads or processes (reconstructTile()) and their
+ * results brought back to stitchTiles(). */
+struct TilePlan {
+  /** Why there is no plan (bad options or ids); empty if there is one. */
+  std::string error;
+  /** The cloud fits one tile (TilingOptions::tile_points is 0 or at least the number
+   * of finite points): runTiled() then calls run() on the whole, which the phases
+   * below do not reproduce exactly. The plan is still one of one tile, no halo. */
+  bool one_piece = false;
+  /** Number of points planned (finite or not). */
+  std::size_t points = 0;
+  /** The finite points' positions, core after core: tile t's core is
+   * order[core_begin[t]] to order[core_begin[t + 1] - 1]. */
+  std::vector<int> order;
+  /** Where each core starts in \a order; one more entry than there are tiles. */
+  std::vector<std::size_t> core_begin;
+  /** Per tile, the positions of its halo points (in other tiles' cores), in the order
+   * of the tiles. */
+  std::vector<std::vector<int>> halo;
+  /** Per point, the tile whose core holds it; -1 if it is not finite. */
+  std::vector<int> point_tile;
+  /** The centre of the finite points' box: the Result's offset. */
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  /** Wall-clock time of the plan, in milliseconds. */
+  double cut_ms = 0.0;
+
+  /** Number of tiles. */
+  std::size_t
+  tiles() const
+  {
+    return core_begin.empty() ? 0 : core_begin.size() - 1;
+  }
+
+  /** Number of points in the core of \a tile. */
+  std::size_t
+  coreSize(std::size_t tile) const
+  {
+    return core_begin[tile + 1] - core_begin[tile];
+  }
+
+  /** The positions of \a tile's points, its core first, then its halo: the points
+   * reconstructTile() takes, in that order. */
+  std::vector<int>
+  tilePoints(std::size_t tile) const;
+};
+
+/** \brief What one tile leaves for stitchTiles(): the labels of its core, the
+ * triangles it keeps and the others of its mesh.
+ *
+ * Plain vectors over the caller's ids (no pointers into the cloud), so that it can be
+ * made in another process and sent back. The per-core-point fields follow the order
+ * of the core in the TilePlan. */
+struct TileResult {
+  /** A failure that fails the run (no memory, no thread, bad input); empty if none. */
+  std::string error;
+  /** Why the tile's points give no mesh (run()'s error); empty if they do. Such a
+   * tile does not fail the run: its core points are labelled undersampled. */
+  std::string degenerate;
+  /** The points the tile was reconstructed from (core and halo). */
+  std::size_t points = 0;
+  /** Per core point: the caller id of its vertex's representative, -2 for an
+   * outlier. */
+  std::vector<int> representative;
+  /** Per core point: bit 0 boundary, bit 1 umbrella failure. */
+  std::vector<std::uint8_t> flags;
+  /** Per core point its noise level; empty without noise handling. */
+  std::vector<float> noise;
+  /** Per core point that represents its vertex, in the order of the core: the
+   * position (in the caller's frame) and the normal. */
+  std::vector<Eigen::Vector3d> position, normal;
+  /** The triangles the tile keeps (the ownership rule, see runTiled()), oriented,
+   * over caller ids. */
+  std::vector<Triangle> kept;
+  /** The tile's other triangles, each with its ids ascending: they may close a seam
+   * hole where the tiles that own them disagree. */
+  std::vector<Triangle> seen;
+  /** The ratio the tile used, its noise level after smoothing (0 if it did not try),
+   * whether it smoothed. */
+  double ratio = 0.0;
+  double noise_after_smoothing = 0.0;
+  bool smoothed = false;
+  /** The tile's counts and timings (halo included). */
+  ReconstructionCounts counts;
+  Timings timings;
+};
+
+/** \brief Cut \a points into tiles with their halos: the first phase of runTiled().
+ *
+ * See runTiled() for the cut and the halo. The halos are found with up to
+ * Parameters::threads threads; nothing else of \a parameters is used.
+ *
+ * \param[in] points the points; non-finite points and duplicates are allowed
+ * \param[in] parameters the threads to use
+ * \param[in] tiling how to cut the cloud
+ * \param[in] ids the caller's id of each point, distinct; empty: the position in
+ *            \a points (checked here, so that a bad list fails before any work)
+ * \return the plan, or one with TilePlan::error set
+ */
+TilePlan
+planTiles(const std::vector<Eigen::Vector3d>& points,
+          const Parameters& parameters,
+          const TilingOptions& tiling,
+          const std::vector<int>& ids = {});
+
+/** \brief Reconstruct one tile of a plan: the second phase of runTiled().
+ *
+ * Gathers the tile's points (TilePlan::tilePoints()) and their ids and calls the
+ * overload below. Tiles are independent: any number may run at once, in any order.
+ *
+ * \param[in] plan the plan of \a points
+ * \param[in] tile the tile, below plan.tiles()
+ * \param[in] points the points the plan was made of
+ * \param[in] parameters the parameters of the tile's run()
+ * \param[in] ids the caller's ids the plan was made with
+ */
+TileResult
+reconstructTile(const TilePlan& plan,
+                std::size_t tile,
+                const std::vector<Eigen::Vector3d>& points,
+                const Parameters& parameters,
+                const std::vector<int>& ids = {});
+
+/** \brief Reconstruct one tile from its own points, which is all a remote worker
+ * needs: run() on the points, then the labels of the core and the triangles the tile
+ * keeps.
+ *
+ * The result depends only on the arguments (not on Parameters::threads, nor on where
+ * or how often it runs). Never throws: a failure is TileResult::error.
+ *
+ * \param[in] points the tile's points, its core first (TilePlan::tilePoints())
+ * \param[in] ids their caller ids, distinct, as many as \a points
+ * \param[in] core_points how many of \a points are the core
+ * \param[in] parameters the parameters of the tile's run()
+ */
+TileResult
+reconstructTile(std::vector<Eigen::Vector3d> points,
+                const std::vector<int>& ids,
+                std::size_t core_points,
+                const Parameters& parameters);
+
+/** \brief Stitch the tiles' results into one mesh: the last phase of runTiled().
+ *
+ * With the results of every tile of \a plan (in the order of the tiles, each made
+ * from the points and ids of the plan with the same parameters), the Result is that
+ * of runTiled() for a plan of more than one tile, whatever made the results. Taken
+ * by value, so that the caller can move them in and the stitch free them as it goes.
+ *
+ * \param[in] plan the plan
+ * \param[in] results one per tile, in the order of the tiles
+ * \param[in] parameters the parameters of the tiles (noise handling, threads)
+ * \param[in] ids the caller's ids the plan was made with
+ * \param[out] report if given, what the tiling did (all but tiles_ms, which the
+ *             caller measures)
+ * \return the stitched mesh; Result::error if a tile failed, the results do not fit
+ *         the plan, or no tile has a mesh
+ */
+Result
+stitchTiles(TilePlan plan,
+            std::vector<TileResult> results,
+            const Parameters& parameters,
+            const std::vector<int>& ids = {},
+            TilingReport* report = nullptr);
+
 /** \brief Reconstruct tile by tile: the result of run() for a cloud too large for
  * one triangulation.
  *
@@ -83,7 +252,8 @@ struct TilingReport {
  * at most TilingOptions::tile_points points and every point is in exactly one core.
  * A tile is its core plus the halo: the other points within TilingOptions::
  * halo_spacings local spacings of the core's box. run() reconstructs each tile on
- * its own, with the caller's ids.
+ * its own, with the caller's ids. The three phases are planTiles(), reconstructTile()
+ * per tile and stitchTiles(); runTiled() is them, in one process.
  *
  * Ownership rule: a triangle is kept by exactly one tile, the one whose core holds
  * the triangle's vertex with the smallest caller id (the vertex's representative,
