@@ -15,6 +15,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -41,7 +42,7 @@ struct Result {
 const char* const PARAMETER_NAMES =
     "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
     "noise_handling, noise_threshold, smoothing_iterations, fill_undersampled_holes, "
-    "threads, tile_points (reconstruct only)";
+    "threads, tile_points and halo_spacings (not for detect_boundary)";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -192,6 +193,14 @@ parseParameters(const char* function,
           static_cast<double>(points));
       tiling->tile_points = static_cast<std::size_t>(points);
     }
+    else if (name == "halo_spacings" && tiling) {
+      tiling->halo_spacings = toDouble(function, name, value);
+      requireValue(std::isfinite(tiling->halo_spacings) && tiling->halo_spacings >= 0.0,
+                   function,
+                   name,
+                   "finite and >= 0",
+                   tiling->halo_spacings);
+    }
     else
       throw py::type_error(std::string(function) +
                            "() got an unexpected keyword argument '" + name +
@@ -302,42 +311,49 @@ parametersDict(const cocone::Parameters& p, const cocone::TilingOptions& tiling 
   d["smoothing_iterations"] = p.smoothing_iterations;
   d["threads"] = p.threads;
   d["tile_points"] = tiling.tile_points;
+  d["halo_spacings"] = tiling.halo_spacings;
   return d;
 }
 
-Result
-runPipeline(const char* function,
-            const py::object& points,
-            const py::kwargs& kwargs,
-            cocone::Stages stages)
+/** The points of \a points (see pointArray()) as the vector run() takes; call without
+ * the GIL. */
+std::vector<Eigen::Vector3d>
+readPointArray(const py::array& array)
 {
-  cocone::TilingOptions tiling;
-  const cocone::Parameters parameters = parseParameters(
-      function, kwargs, stages == cocone::Stages::RECONSTRUCTION ? &tiling : nullptr);
-  const py::array array = pointArray(function, points);
-  const bool single = array.dtype().itemsize() == 4;
-  const auto n = static_cast<std::size_t>(array.shape(0));
+  return array.dtype().itemsize() == 4 ? readPoints<float>(array)
+                                       : readPoints<double>(array);
+}
 
-  cocone::Result r;
-  double input_ms = 0.0, run_ms = 0.0;
-  {
-    // The array stays referenced (by `array`) while the GIL is released; nothing here
-    // touches a Python object.
-    py::gil_scoped_release release;
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    std::vector<Eigen::Vector3d> xyz =
-        single ? readPoints<float>(array) : readPoints<double>(array);
-    const auto t1 = Clock::now();
-    r = tiling.tile_points > 0 ? cocone::runTiled(std::move(xyz), parameters, tiling)
-                               : cocone::run(std::move(xyz), parameters, stages);
-    const auto t2 = Clock::now();
-    input_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    run_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
-  }
-  if (!r.error.empty())
-    throw std::runtime_error(std::string(function) + "(): " + r.error);
+py::dict
+tilingDict(const cocone::TilingReport& t)
+{
+  py::dict d;
+  d["tiles"] = t.tiles;
+  d["halo_points"] = t.halo_points;
+  d["largest_tile"] = t.largest_tile;
+  d["patches"] = t.patches;
+  d["patches_flipped"] = t.patches_flipped;
+  d["seam_dropped"] = t.seam_dropped;
+  d["seam_filled"] = t.seam_filled;
+  d["degenerate_tiles"] = t.degenerate_tiles;
+  d["cut_ms"] = t.cut_ms;
+  d["tiles_ms"] = t.tiles_ms;
+  d["stitch_ms"] = t.stitch_ms;
+  return d;
+}
 
+/** The Python Result of \a r, a run over \a n points; \a tiling_report if the
+ * run was tiled. */
+Result
+toPython(cocone::Result& r,
+         std::size_t n,
+         cocone::Stages stages,
+         const cocone::Parameters& parameters,
+         const cocone::TilingOptions& tiling,
+         const cocone::TilingReport* tiling_report,
+         double input_ms,
+         double run_ms)
+{
   Result out;
   // Normals per input point: its vertex's, NaN for points not in the mesh and for the
   // points that are not finite (or set aside).
@@ -428,7 +444,317 @@ runPipeline(const char* function,
   report["parameters"] = parametersDict(parameters, tiling);
   report["timings_ms"] = timings;
   report["counts"] = counts;
+  if (tiling_report)
+    report["tiling"] = tilingDict(*tiling_report);
   return out;
+}
+
+Result
+runPipeline(const char* function,
+            const py::object& points,
+            const py::kwargs& kwargs,
+            cocone::Stages stages)
+{
+  cocone::TilingOptions tiling;
+  const cocone::Parameters parameters = parseParameters(
+      function, kwargs, stages == cocone::Stages::RECONSTRUCTION ? &tiling : nullptr);
+  const py::array array = pointArray(function, points);
+  const auto n = static_cast<std::size_t>(array.shape(0));
+
+  cocone::Result r;
+  cocone::TilingReport tiling_report;
+  double input_ms = 0.0, run_ms = 0.0;
+  {
+    // The array stays referenced (by `array`) while the GIL is released; nothing here
+    // touches a Python object.
+    py::gil_scoped_release release;
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    std::vector<Eigen::Vector3d> xyz = readPointArray(array);
+    const auto t1 = Clock::now();
+    r = tiling.tile_points > 0
+            ? cocone::runTiled(std::move(xyz), parameters, tiling, {}, &tiling_report)
+            : cocone::run(std::move(xyz), parameters, stages);
+    const auto t2 = Clock::now();
+    input_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    run_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  }
+  if (!r.error.empty())
+    throw std::runtime_error(std::string(function) + "(): " + r.error);
+  return toPython(r,
+                  n,
+                  stages,
+                  parameters,
+                  tiling,
+                  tiling.tile_points > 0 ? &tiling_report : nullptr,
+                  input_ms,
+                  run_ms);
+}
+
+// Tiles: the phases of runTiled() (include/pcl/surface/cocone/tiling.h), so that the
+// tiles can run in other processes (pcl_cocone.tiled runs them on a Dask cluster).
+
+static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "a position is 3 doubles");
+
+/** Call \a f(name, field) for every count of \a c (the names of the report's). */
+template <typename Counts, typename F>
+void
+eachCount(Counts& c, const F& f)
+{
+  f("candidates", c.candidates);
+  f("umbrella_failures", c.umbrella_failures);
+  f("pruned", c.pruned);
+  f("walk_components", c.walk_components);
+  f("walked", c.walked);
+  f("walk_conflicts", c.walk_conflicts);
+  f("walk_reseeds", c.walk_reseeds);
+  f("repair.nonmanifold_edge", c.repair.nonmanifold_edge);
+  f("repair.nonmanifold_vertex", c.repair.nonmanifold_vertex);
+  f("repair.orientation", c.repair.orientation);
+  f("repair.flipped", c.repair.flipped);
+  f("repair.filled", c.repair.filled);
+  f("repair.ribbon", c.repair.ribbon);
+  f("holes_filled", c.holes_filled);
+  f("hole_triangles", c.hole_triangles);
+}
+
+template <typename Timings, typename F>
+void
+eachTiming(Timings& t, const F& f)
+{
+  f("unique", t.unique);
+  f("delaunay", t.delaunay);
+  f("noise", t.noise);
+  f("voronoi", t.voronoi);
+  f("boundary", t.boundary);
+  f("reconstruction", t.reconstruction);
+}
+
+/** A copy of \a v as an array of \a columns columns of \a S (rows of \a T). NumPy
+ * owns the copy, so that Dask's serialization sends it like any array (it cannot
+ * pickle the capsule of ownedArray()). */
+template <typename S, typename T>
+py::array_t<S>
+copyArray(const std::vector<T>& v, py::ssize_t columns)
+{
+  static_assert(sizeof(T) % sizeof(S) == 0, "rows of whole values");
+  const auto size = static_cast<py::ssize_t>(v.size() * sizeof(T) / sizeof(S));
+  py::array_t<S> array = columns == 1 ? py::array_t<S>(std::vector<py::ssize_t>{size})
+                                      : py::array_t<S>({size / columns, columns});
+  if (size > 0)
+    std::memcpy(
+        array.mutable_data(), v.data(), static_cast<std::size_t>(size) * sizeof(S));
+  return array;
+}
+
+/** The tile result as a dict of plain values and NumPy arrays (what it pickles to). */
+py::dict
+tileToDict(const cocone::TileResult& o)
+{
+  py::dict d;
+  d["error"] = o.error;
+  d["degenerate"] = o.degenerate;
+  d["points"] = o.points;
+  d["representative"] = copyArray<int>(o.representative, 1);
+  d["flags"] = copyArray<std::uint8_t>(o.flags, 1);
+  d["noise"] = copyArray<float>(o.noise, 1);
+  d["position"] = copyArray<double>(o.position, 3);
+  d["normal"] = copyArray<double>(o.normal, 3);
+  d["kept"] = copyArray<int>(o.kept, 3);
+  d["seen"] = copyArray<int>(o.seen, 3);
+  d["ratio"] = o.ratio;
+  d["noise_after_smoothing"] = o.noise_after_smoothing;
+  d["smoothed"] = o.smoothed;
+  py::dict counts, timings;
+  eachCount(o.counts, [&](const char* name, std::size_t v) { counts[name] = v; });
+  eachTiming(o.timings, [&](const char* name, double v) { timings[name] = v; });
+  d["counts"] = counts;
+  d["timings_ms"] = timings;
+  return d;
+}
+
+/** The array \a d[name] of \a columns columns (1: one dimension) as rows of \a T. */
+template <typename S, typename T>
+std::vector<T>
+arrayField(const py::dict& d, const char* name, py::ssize_t columns)
+{
+  const char* kind = std::is_floating_point_v<S> ? "real" : "integer";
+  const py::array array = py::array::ensure(d[name]);
+  const bool right_kind =
+      array && (std::is_floating_point_v<S>
+                    ? array.dtype().kind() == 'f'
+                    : (array.dtype().kind() == 'i' || array.dtype().kind() == 'u'));
+  const bool right_shape =
+      array && (columns == 1 ? array.ndim() == 1
+                             : array.ndim() == 2 && array.shape(1) == columns);
+  if (!right_kind || !right_shape)
+    throw py::value_error("TileResult.from_dict(): '" + std::string(name) +
+                          "' must be an array of " + kind + "s with " +
+                          std::to_string(columns) + " column(s)");
+  const auto converted =
+      py::array_t<S, py::array::c_style | py::array::forcecast>::ensure(array);
+  std::vector<T> v(static_cast<std::size_t>(converted.size()) * sizeof(S) / sizeof(T));
+  if (!v.empty())
+    std::memcpy(static_cast<void*>(v.data()), converted.data(), v.size() * sizeof(T));
+  return v;
+}
+
+cocone::TileResult
+tileFromDict(const py::dict& d)
+{
+  for (const char* key : {"error",
+                          "degenerate",
+                          "points",
+                          "representative",
+                          "flags",
+                          "noise",
+                          "position",
+                          "normal",
+                          "kept",
+                          "seen",
+                          "ratio",
+                          "noise_after_smoothing",
+                          "smoothed",
+                          "counts",
+                          "timings_ms"})
+    if (!d.contains(key))
+      throw py::value_error(std::string("TileResult.from_dict(): no '") + key + "'");
+  cocone::TileResult o;
+  o.error = d["error"].cast<std::string>();
+  o.degenerate = d["degenerate"].cast<std::string>();
+  o.points = d["points"].cast<std::size_t>();
+  o.representative = arrayField<int, int>(d, "representative", 1);
+  o.flags = arrayField<std::uint8_t, std::uint8_t>(d, "flags", 1);
+  o.noise = arrayField<float, float>(d, "noise", 1);
+  o.position = arrayField<double, Eigen::Vector3d>(d, "position", 3);
+  o.normal = arrayField<double, Eigen::Vector3d>(d, "normal", 3);
+  o.kept = arrayField<int, cocone::Triangle>(d, "kept", 3);
+  o.seen = arrayField<int, cocone::Triangle>(d, "seen", 3);
+  o.ratio = d["ratio"].cast<double>();
+  o.noise_after_smoothing = d["noise_after_smoothing"].cast<double>();
+  o.smoothed = d["smoothed"].cast<bool>();
+  const py::dict counts = d["counts"], timings = d["timings_ms"];
+  eachCount(o.counts, [&](const char* name, std::size_t& v) {
+    if (counts.contains(name))
+      v = counts[name].cast<std::size_t>();
+  });
+  eachTiming(o.timings, [&](const char* name, double& v) {
+    if (timings.contains(name))
+      v = timings[name].cast<double>();
+  });
+  return o;
+}
+
+/** Caller ids: integers that fit an int, one per point. */
+std::vector<int>
+idVector(const char* function, const py::object& ids, std::size_t n)
+{
+  const py::array array = py::array::ensure(ids);
+  if (!array || (array.dtype().kind() != 'i' && array.dtype().kind() != 'u') ||
+      array.ndim() != 1)
+    throw py::type_error(std::string(function) +
+                         "(): ids must be a one-dimensional array of integers");
+  if (static_cast<std::size_t>(array.shape(0)) != n)
+    throw py::value_error(std::string(function) +
+                          "(): " + std::to_string(array.shape(0)) + " ids for " +
+                          std::to_string(n) + " points");
+  const auto wide =
+      py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(array);
+  std::vector<int> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const long long v = wide.data()[i];
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      throw py::value_error(std::string(function) + "(): id " + std::to_string(v) +
+                            " does not fit in 32 bits");
+    out[i] = static_cast<int>(v);
+  }
+  return out;
+}
+
+cocone::TilePlan
+planTiles(const py::object& points, const py::kwargs& kwargs)
+{
+  cocone::TilingOptions tiling;
+  const cocone::Parameters parameters = parseParameters("plan_tiles", kwargs, &tiling);
+  const py::array array = pointArray("plan_tiles", points);
+  cocone::TilePlan plan;
+  {
+    py::gil_scoped_release release;
+    plan = cocone::planTiles(readPointArray(array), parameters, tiling);
+  }
+  if (!plan.error.empty())
+    throw std::runtime_error("plan_tiles(): " + plan.error);
+  return plan;
+}
+
+cocone::TileResult
+reconstructTile(const py::object& points,
+                const py::object& ids,
+                py::ssize_t core_points,
+                const py::kwargs& kwargs)
+{
+  cocone::TilingOptions unused; // the same keywords as plan_tiles() take
+  const cocone::Parameters parameters =
+      parseParameters("reconstruct_tile", kwargs, &unused);
+  const py::array array = pointArray("reconstruct_tile", points);
+  const auto n = static_cast<std::size_t>(array.shape(0));
+  const std::vector<int> id_list = idVector("reconstruct_tile", ids, n);
+  if (core_points < 0 || static_cast<std::size_t>(core_points) > n)
+    throw py::value_error("reconstruct_tile(): core_points must be in [0, " +
+                          std::to_string(n) + "], got " + std::to_string(core_points));
+  cocone::TileResult result;
+  {
+    py::gil_scoped_release release;
+    result = cocone::reconstructTile(readPointArray(array),
+                                     id_list,
+                                     static_cast<std::size_t>(core_points),
+                                     parameters);
+  }
+  if (!result.error.empty())
+    throw std::runtime_error("reconstruct_tile(): " + result.error);
+  return result;
+}
+
+Result
+stitchTiles(const cocone::TilePlan& plan,
+            const py::sequence& results,
+            const py::kwargs& kwargs)
+{
+  cocone::TilingOptions tiling;
+  const cocone::Parameters parameters =
+      parseParameters("stitch_tiles", kwargs, &tiling);
+  std::vector<const cocone::TileResult*> held; // alive: `results` holds them
+  for (const auto item : results) {
+    if (!py::isinstance<cocone::TileResult>(item))
+      throw py::type_error("stitch_tiles(): results must be TileResult objects, not " +
+                           std::string(Py_TYPE(item.ptr())->tp_name));
+    held.push_back(&item.cast<const cocone::TileResult&>());
+  }
+  cocone::Result r;
+  cocone::TilingReport report;
+  double run_ms = 0.0;
+  {
+    py::gil_scoped_release release;
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<cocone::TileResult> copies;
+    copies.reserve(held.size());
+    for (const auto* h : held)
+      copies.push_back(*h);
+    r = cocone::stitchTiles(plan, std::move(copies), parameters, {}, &report);
+    run_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+            .count();
+  }
+  if (!r.error.empty())
+    throw std::runtime_error("stitch_tiles(): " + r.error);
+  return toPython(r,
+                  plan.points,
+                  cocone::Stages::RECONSTRUCTION,
+                  parameters,
+                  tiling,
+                  &report,
+                  0.0,
+                  run_ms);
 }
 
 } // namespace
@@ -500,7 +826,7 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
       "that triangles of the local spacing close are closed; default True), threads, "
       "tile_points (in tiles of at most this many points, stitched; default 0: one "
-      "piece). "
+      "piece), halo_spacings (the tiles' halo in spacings, default 8). "
       "Runs without the GIL.");
   m.def(
       "detect_boundary",
@@ -513,6 +839,111 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "Stages 1-3 only: the undersampled points of (N, 3) points, no mesh "
       "(triangles and border_loops empty, normals NaN). Same parameters as "
       "reconstruct().");
+  py::class_<cocone::TilePlan>(
+      m,
+      "TilePlan",
+      "How plan_tiles() cut a cloud: each tile's core and halo, as indices of the "
+      "points.")
+      .def_property_readonly("tiles", &cocone::TilePlan::tiles, "Number of tiles.")
+      .def_readonly("one_piece",
+                    &cocone::TilePlan::one_piece,
+                    "The cloud fits one tile: reconstruct() with the same tile_points "
+                    "runs it in one piece, which the phases do not reproduce exactly.")
+      .def_readonly("points", &cocone::TilePlan::points, "Number of points planned.")
+      .def_readonly("cut_ms", &cocone::TilePlan::cut_ms, "Time of the plan (ms).")
+      .def_property_readonly(
+          "point_tile",
+          [](const cocone::TilePlan& p) { return copyArray<int>(p.point_tile, 1); },
+          "(N,) int32: the tile whose core holds each point, -1 if it is not finite.")
+      .def(
+          "core_size",
+          [](const cocone::TilePlan& p, std::size_t t) {
+            if (t >= p.tiles())
+              throw py::index_error("no tile " + std::to_string(t));
+            return p.coreSize(t);
+          },
+          py::arg("tile"),
+          "Number of points in the core of a tile.")
+      .def(
+          "tile_points",
+          [](const cocone::TilePlan& p, std::size_t t) {
+            if (t >= p.tiles())
+              throw py::index_error("no tile " + std::to_string(t));
+            return copyArray<int>(p.tilePoints(t), 1);
+          },
+          py::arg("tile"),
+          "int32: the indices of a tile's points, its core (core_size) first, then "
+          "its halo: what reconstruct_tile() takes.")
+      .def("__repr__", [](const cocone::TilePlan& p) {
+        return "<pcl_cocone.TilePlan: " + std::to_string(p.tiles()) + " tiles of " +
+               std::to_string(p.points) + " points>";
+      });
+
+  py::class_<cocone::TileResult>(
+      m,
+      "TileResult",
+      "What reconstruct_tile() returns and stitch_tiles() takes: plain arrays, "
+      "picklable (to_dict(), from_dict()) so that a worker process can send it back.")
+      .def_readonly("degenerate",
+                    &cocone::TileResult::degenerate,
+                    "Why the tile's points give no mesh; empty if they do.")
+      .def_readonly(
+          "points", &cocone::TileResult::points, "Points of the tile (core and halo).")
+      .def_property_readonly(
+          "kept",
+          [](const cocone::TileResult& o) { return o.kept.size(); },
+          "Number of triangles the tile keeps.")
+      .def_property_readonly(
+          "timings_ms",
+          [](const cocone::TileResult& o) {
+            py::dict timings;
+            eachTiming(o.timings,
+                       [&](const char* name, double v) { timings[name] = v; });
+            return timings;
+          },
+          "dict: the tile's time per stage in milliseconds.")
+      .def("to_dict",
+           &tileToDict,
+           "The fields as a dict of plain values and NumPy arrays (copies).")
+      .def_static("from_dict",
+                  &tileFromDict,
+                  py::arg("fields"),
+                  "A TileResult from the dict to_dict() gives; ValueError if a field "
+                  "is missing or of the wrong shape.")
+      .def(py::pickle([](const cocone::TileResult& o) { return tileToDict(o); },
+                      [](const py::dict& d) { return tileFromDict(d); }))
+      .def("__repr__", [](const cocone::TileResult& o) {
+        return "<pcl_cocone.TileResult: " + std::to_string(o.points) + " points, " +
+               std::to_string(o.kept.size()) + " kept triangles>";
+      });
+
+  m.def("plan_tiles",
+        &planTiles,
+        py::arg("points"),
+        "plan_tiles(points, **parameters) -> TilePlan\n\n"
+        "Cut (N, 3) points into tiles of at most tile_points points in the core, "
+        "with a halo of halo_spacings spacings (the first phase of reconstruct() with "
+        "tile_points). Uses tile_points, halo_spacings and threads of the parameters. "
+        "Runs without the GIL.");
+  m.def("reconstruct_tile",
+        &reconstructTile,
+        py::arg("points"),
+        py::arg("ids"),
+        py::arg("core_points"),
+        "reconstruct_tile(points, ids, core_points, **parameters) -> TileResult\n\n"
+        "Reconstruct one tile from its own points (points[plan.tile_points(t)], the "
+        "core first), their ids (plan.tile_points(t)) and the size of the core. The "
+        "result depends on nothing else: not on the process, the threads or how "
+        "often it runs. RuntimeError if it fails. Runs without the GIL.");
+  m.def("stitch_tiles",
+        &stitchTiles,
+        py::arg("plan"),
+        py::arg("results"),
+        "stitch_tiles(plan, results, **parameters) -> Result\n\n"
+        "Stitch one TileResult per tile, in the order of the tiles, into the Result "
+        "reconstruct(points, tile_points=...) gives (with the same parameters as the "
+        "tiles). RuntimeError if a result does not fit the plan. Runs without the "
+        "GIL.");
   m.def(
       "default_parameters",
       []() { return parametersDict(cocone::Parameters()); },

@@ -19,8 +19,20 @@ which it is smoothed, >= 0), smoothing_iterations (>= 1), threads (0: all
 processors). An unknown name raises TypeError, a value out of range ValueError; a
 cloud with no result (fewer than 4 distinct finite points, collinear points)
 RuntimeError. The computation releases the GIL.
+
+Tiles (reconstruct(points, tile_points=N) in three phases, for other processes):
+    plan = pcl_cocone.plan_tiles(points, tile_points=N)
+    results = [pcl_cocone.reconstruct_tile(points[plan.tile_points(t)],
+                                           plan.tile_points(t), plan.core_size(t))
+               for t in range(plan.tiles)]          # anywhere: picklable, any order
+    result = pcl_cocone.stitch_tiles(plan, results)  # as reconstruct() with tile_points
+The same keyword parameters go to all three. python3 -m pcl_cocone.tiled runs the tiles
+on a Dask cluster (pcl_cocone/tiled.py).
 """
 
-from ._pcl_cocone import Result, default_parameters, detect_boundary, reconstruct
+from ._pcl_cocone import (Result, TilePlan, TileResult, default_parameters,
+                          detect_boundary, plan_tiles, reconstruct, reconstruct_tile,
+                          stitch_tiles)
 
-__all__ = ["Result", "default_parameters", "detect_boundary", "reconstruct"]
+__all__ = ["Result", "TilePlan", "TileResult", "default_parameters", "detect_boundary",
+           "plan_tiles", "reconstruct", "reconstruct_tile", "stitch_tiles"]

@@ -1,6 +1,7 @@
 """Tests of the Python bindings (run from ctest as python_bindings)."""
 
 import math
+import pickle
 import threading
 import time
 
@@ -215,7 +216,8 @@ def test_parameters_are_used():
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
                              "cocone_angle", "boundary_detection", "noise_handling",
                              "noise_threshold", "smoothing_iterations",
-                             "fill_undersampled_holes", "threads", "tile_points"}
+                             "fill_undersampled_holes", "threads", "tile_points",
+                             "halo_spacings"}
     assert defaults["noise_handling"] is True
     assert defaults["fill_undersampled_holes"] is True
     assert defaults["smoothing_iterations"] >= 1
@@ -242,6 +244,119 @@ def test_tiles():
         pcl_cocone.reconstruct(points, tile_points=5)
     with pytest.raises(TypeError, match="tile_points"):
         pcl_cocone.detect_boundary(points, tile_points=1000)
+
+
+def torus(n, seed=4, noise=0.0):
+    """n random points on the torus of radii 1 and 0.4, evenly spread by area."""
+    rng = np.random.default_rng(seed)
+    u, v = np.empty(0), np.empty(0)
+    while len(u) < n:
+        a, b = rng.uniform(0.0, 2.0 * math.pi, (2, n))
+        keep = rng.uniform(0.0, 1.4, n) < 1.0 + 0.4 * np.cos(b)
+        u, v = np.concatenate((u, a[keep])), np.concatenate((v, b[keep]))
+    u, v = u[:n], v[:n]
+    r = 1.0 + 0.4 * np.cos(v)
+    points = np.column_stack((r * np.cos(u), r * np.sin(u), 0.4 * np.sin(v)))
+    return points + rng.normal(0.0, noise, points.shape)
+
+
+def same_result(a, b):
+    assert np.array_equal(a.triangles, b.triangles)
+    assert np.array_equal(a.normals, b.normals, equal_nan=True)
+    assert np.array_equal(a.boundary_indices, b.boundary_indices)
+    assert np.array_equal(a.outlier_indices, b.outlier_indices)
+    assert np.array_equal(a.point_noise, b.point_noise, equal_nan=True)
+    assert len(a.border_loops) == len(b.border_loops)
+    for x, y in zip(a.border_loops, b.border_loops):
+        assert np.array_equal(x, y)
+
+
+def test_tile_phases_by_hand_equal_reconstruct_with_tiles():
+    points = torus(12000, noise=1e-3)
+    points[5] = np.nan  # in no tile
+    parameters = {"tile_points": 2000, "threads": 2}
+    whole = pcl_cocone.reconstruct(points, **parameters)
+    assert whole.report["tiling"]["tiles"] >= 4
+    plan = pcl_cocone.plan_tiles(points, **parameters)
+    assert plan.tiles == whole.report["tiling"]["tiles"] and not plan.one_piece
+    assert plan.points == len(points) and plan.point_tile[5] == -1
+    cores = np.concatenate([plan.tile_points(t)[:plan.core_size(t)]
+                            for t in range(plan.tiles)])
+    assert np.array_equal(np.sort(cores), np.delete(np.arange(len(points)), 5))
+    # The tiles in reverse order, one thread each, each sent through pickle as to
+    # another process: the same mesh.
+    results = {}
+    for t in reversed(range(plan.tiles)):
+        ids = plan.tile_points(t)
+        tile = pcl_cocone.reconstruct_tile(points[ids], ids, plan.core_size(t),
+                                           tile_points=2000, threads=1)
+        results[t] = pickle.loads(pickle.dumps(tile, protocol=5))
+        assert results[t].points == len(ids) and results[t].degenerate == ""
+    stitched = pcl_cocone.stitch_tiles(plan, [results[t] for t in range(plan.tiles)],
+                                       **parameters)
+    same_result(stitched, whole)
+    assert stitched.report["tiling"]["halo_points"] == \
+        whole.report["tiling"]["halo_points"]
+    # A cloud that fits a tile is one piece.
+    assert pcl_cocone.plan_tiles(points[:1500], tile_points=2000).one_piece
+
+
+def test_tile_result_to_and_from_dict():
+    points = sphere(3000)
+    plan = pcl_cocone.plan_tiles(points, tile_points=1000)
+    ids = plan.tile_points(1)
+    tile = pcl_cocone.reconstruct_tile(points[ids], ids, plan.core_size(1))
+    fields = tile.to_dict()
+    assert fields["representative"].dtype == np.int32
+    assert fields["representative"].shape == (plan.core_size(1),)
+    assert fields["kept"].shape == (tile.kept, 3)
+    assert fields["position"].shape[1] == 3 and fields["flags"].dtype == np.uint8
+    again = pcl_cocone.TileResult.from_dict(fields).to_dict()
+    assert again.keys() == fields.keys()
+    for key, value in fields.items():
+        if isinstance(value, np.ndarray):
+            assert np.array_equal(value, again[key]), key
+        else:
+            assert value == again[key], key
+    broken = dict(fields)
+    del broken["kept"]
+    with pytest.raises(ValueError, match="kept"):
+        pcl_cocone.TileResult.from_dict(broken)
+    broken = dict(fields, position=np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="position"):
+        pcl_cocone.TileResult.from_dict(broken)
+
+
+def test_tile_errors():
+    points = sphere(3000)
+    with pytest.raises(ValueError, match="tile_points"):
+        pcl_cocone.plan_tiles(points, tile_points=5)
+    plan = pcl_cocone.plan_tiles(points, tile_points=1000)
+    with pytest.raises(IndexError):
+        plan.tile_points(plan.tiles)
+    ids = plan.tile_points(0)
+    tile = points[ids]
+    core = plan.core_size(0)
+    with pytest.raises(ValueError, match="ids for"):
+        pcl_cocone.reconstruct_tile(tile, ids[:-1], core)
+    with pytest.raises(TypeError, match="ids"):
+        pcl_cocone.reconstruct_tile(tile, ids.astype(float), core)
+    with pytest.raises(ValueError, match="core_points"):
+        pcl_cocone.reconstruct_tile(tile, ids, len(ids) + 1)
+    twice = ids.copy()
+    twice[1] = twice[0]
+    with pytest.raises(RuntimeError, match="not distinct"):
+        pcl_cocone.reconstruct_tile(tile, twice, core)
+    results = [pcl_cocone.reconstruct_tile(points[plan.tile_points(t)],
+                                           plan.tile_points(t), plan.core_size(t))
+               for t in range(plan.tiles)]
+    with pytest.raises(RuntimeError, match="tile results for a plan"):
+        pcl_cocone.stitch_tiles(plan, results[:-1])
+    with pytest.raises(RuntimeError, match="does not fit the plan"):
+        pcl_cocone.stitch_tiles(plan, results[::-1])
+    with pytest.raises(TypeError, match="TileResult"):
+        pcl_cocone.stitch_tiles(plan, results[:-1] + [None])
+    assert len(pcl_cocone.stitch_tiles(plan, results).triangles) == 2 * len(points) - 4
 
 
 def test_outliers_far_from_a_sphere():
