@@ -5,7 +5,8 @@
 set -euo pipefail
 packages=(cmake g++ make libpcl-dev libcgal-dev libeigen3-dev libflann-dev
           libgtest-dev pcl-tools xvfb xauth python3-catkin-pkg clang libclang-rt-14-dev
-          doxygen pybind11-dev python3-dev python3-numpy python3-pytest)
+          doxygen pybind11-dev python3-dev python3-numpy python3-pytest
+          python3-distributed)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
