@@ -149,21 +149,25 @@ struct TileResult {
   /** Per core point its noise level; empty without noise handling. */
   std::vector<float> noise;
   /** Per core point that represents its vertex, in the order of the core: the
-   * position (in the caller's frame) and the normal. */
-  std::vector<Eigen::Vector3d> position, normal;
+   * position, in the caller's frame. */
+  std::vector<Eigen::Vector3d> position;
+  /** The normal of each vertex of \a position (NaN in a degenerate tile). */
+  std::vector<Eigen::Vector3d> normal;
   /** The triangles the tile keeps (the ownership rule, see runTiled()), oriented,
    * over caller ids. */
   std::vector<Triangle> kept;
   /** The tile's other triangles, each with its ids ascending: they may close a seam
    * hole where the tiles that own them disagree. */
   std::vector<Triangle> seen;
-  /** The ratio the tile used, its noise level after smoothing (0 if it did not try),
-   * whether it smoothed. */
+  /** The ratio the tile used. */
   double ratio = 0.0;
+  /** The tile's noise level after smoothing; 0 if it did not try. */
   double noise_after_smoothing = 0.0;
+  /** Whether the tile smoothed its points. */
   bool smoothed = false;
-  /** The tile's counts and timings (halo included). */
+  /** The tile's counts (halo included). */
   ReconstructionCounts counts;
+  /** The tile's timings (halo included). */
   Timings timings;
 };
 
