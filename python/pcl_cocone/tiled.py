@@ -307,7 +307,9 @@ def main(argv=None):
         say(f"plan: {figures['tiles']} tiles, largest {figures['largest_tile']} "
             f"points, {figures['halo_points']} halo points "
             f"({figures['plan_seconds']:.2f} s)")
-        say(f"tiles: {figures['tiles']} tasks on {figures['workers']} workers "
+        workers = figures["workers"]
+        say(f"tiles: {figures['tiles']} tasks on {workers} worker"
+            f"{'' if workers == 1 else 's'} "
             f"({figures['tiles_seconds']:.2f} s"
             + (f"; {figures['tile_run_seconds']:.2f} s in the tiles' runs; "
                f"connecting {figures['connect_seconds']:.2f} s)"
