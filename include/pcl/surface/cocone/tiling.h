@@ -87,8 +87,9 @@ struct TilePlan {
   /** Why there is no plan (bad options or ids); empty if there is one. */
   std::string error;
   /** The cloud fits one tile (TilingOptions::tile_points is 0 or at least the number
-   * of finite points): runTiled() then calls run() on the whole, which the phases
-   * below do not reproduce exactly. The plan is still one of one tile, no halo. */
+   * of finite points): runTiled() then calls run() on the whole. The plan is still
+   * one of one tile without a halo, but the phases below would give the stitch of
+   * that tile, not necessarily run()'s result. */
   bool one_piece = false;
   /** Number of points planned (finite or not). */
   std::size_t points = 0;
