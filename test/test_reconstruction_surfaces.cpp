@@ -729,16 +729,99 @@ TEST(HoleFilling, ClosesHolesAsNarrowAsTheSpacingAndKeepsWiderOnes)
   }
 }
 
+TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
+{
+  // A square grid of unit spacing cut along one diagonal, with a round hole, and
+  // another mesh of the same points cut along the other diagonal: no patch of the
+  // other mesh is bounded by the hole's loop (its diagonals are not the other
+  // mesh's), so the band of triangles where they disagree is replaced with the
+  // other mesh's, the hole closed; the grid's outer border, where the other mesh
+  // ends too, stays.
+  const int n = 16;
+  std::vector<Eigen::Vector3d> points;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      points.emplace_back(i, j, 0.0);
+  const auto id = [&](int i, int j) { return j * n + i; };
+  std::vector<pcl::cocone::Triangle> mesh, other;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      other.push_back({a, b, d});
+      other.push_back({b, c, d});
+      for (const pcl::cocone::Triangle& t :
+           {pcl::cocone::Triangle{a, b, c}, pcl::cocone::Triangle{a, c, d}}) {
+        // The hole: the triangles whose centroid is within 2.2 of the middle, so
+        // that diagonals bound it.
+        const Eigen::Vector3d centroid =
+            (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0 -
+            Eigen::Vector3d(n / 2.0, n / 2.0, 0.0);
+        if (centroid.norm() >= 2.2)
+          mesh.push_back(t);
+      }
+    }
+  const std::size_t cut = mesh.size();
+  const std::vector<double> spacing(points.size(), 1.0);
+  pcl::cocone::EdgeIncidences incidences(mesh);
+  auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+  ASSERT_EQ(loops.size(), 2u);
+  std::size_t hole_edges = 0;
+  for (const auto& loop : loops)
+    hole_edges = std::max(hole_edges, loop.size() == 4u * (n - 1) ? 0 : loop.size());
+
+  // Only patches bounded by the loop itself: none.
+  auto unchanged = mesh;
+  auto unchanged_incidences = incidences;
+  auto unchanged_loops = loops;
+  const auto none = pcl::cocone::fillHolesFromMesh(points,
+                                                   spacing,
+                                                   other,
+                                                   unchanged,
+                                                   unchanged_incidences,
+                                                   unchanged_loops,
+                                                   2.75,
+                                                   1000,
+                                                   0);
+  EXPECT_EQ(none.holes, 0u);
+  EXPECT_EQ(unchanged, mesh);
+
+  const auto filled = pcl::cocone::fillHolesFromMesh(
+      points, spacing, other, mesh, incidences, loops, 2.75, 1000, 3);
+  EXPECT_EQ(filled.holes, 1u);
+  ASSERT_EQ(filled.sizes.size(), 1u);
+  EXPECT_EQ(filled.sizes[0], hole_edges);
+  const auto topology = pcl::cocone::analyzeMesh(mesh, points.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.euler, 1); // a disk
+  EXPECT_EQ(topology.components, 1u);
+  EXPECT_EQ(topology.boundary_edges, 4u * (n - 1));
+  EXPECT_EQ(mesh.size(), 2u * (n - 1) * (n - 1));
+  EXPECT_GT(mesh.size(), cut);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0].size(), 4u * (n - 1));
+  // The incidences are those of the mesh.
+  const pcl::cocone::EdgeIncidences fresh(mesh);
+  EXPECT_EQ(incidences.edges, fresh.edges);
+  EXPECT_EQ(incidences.triangle, fresh.triangle);
+  // Every triangle faces as the grid's (+z).
+  for (const auto& t : mesh)
+    EXPECT_GT((points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).z(),
+              0.0);
+}
+
 TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)
 {
-  // Coarse random samples: a cube of 800 points (sharp edges and corners) and the
-  // genus-2 surface of 1,500 leave undersampled holes that the step closes.
+  // Coarse random samples: cubes of 800 and 3,000 points (sharp edges and corners;
+  // at 3,000 a corner's patch replaces a band of the mesh with the advancing
+  // front's triangles) and the genus-2 surface of 1,500 leave undersampled holes
+  // that the step closes.
   struct Case {
     cocone_test::Sample sample;
     long euler;
   };
   for (const auto& c :
        {Case{cocone_test::cube(cocone_test::options(800, 0, 1, false)), 2},
+        Case{cocone_test::cube(cocone_test::options(3000, 0, 1, false)), 2},
         Case{cocone_test::genus2(cocone_test::options(1500, 0, 1, false)), -2}}) {
     SCOPED_TRACE(c.sample.name);
     pcl::cocone::Parameters off;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -160,6 +161,118 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
   return out;
 }
 
+namespace {
+
+/** The oriented manifold mesh that fillHolesFromMesh() changes: triangles taken out
+ * are marked dead (the list and its incidences are brought up to date once, at the
+ * end), each vertex knows its triangles. */
+class LocalMesh {
+public:
+  LocalMesh(std::vector<Triangle>& triangles, std::size_t num_vertices)
+  : triangles_(triangles)
+  , dead_(triangles.size(), 0)
+  , star_(num_vertices)
+  , uses_(num_vertices, 0)
+  {
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (const int v : triangles[t]) {
+        star_[v].push_back(static_cast<int>(t));
+        ++uses_[v];
+      }
+  }
+
+  const std::vector<Triangle>&
+  triangles() const
+  {
+    return triangles_;
+  }
+  const std::vector<std::uint8_t>&
+  dead() const
+  {
+    return dead_;
+  }
+  /** The live triangles at vertex v. */
+  template <typename Body>
+  void
+  forStar(int v, const Body& body) const
+  {
+    for (const int t : star_[v])
+      if (!dead_[t])
+        body(t);
+  }
+  /** Number of live triangles using vertex v. */
+  int
+  uses(int v) const
+  {
+    return uses_[v];
+  }
+  /** The live triangle that traverses the directed edge a -> b, or -1. */
+  int
+  traversing(int a, int b) const
+  {
+    int found = -1;
+    forStar(a, [&](int t) {
+      for (int c = 0; c < 3; ++c)
+        if (triangles_[t][c] == a && triangles_[t][(c + 1) % 3] == b)
+          found = t;
+    });
+    return found;
+  }
+  /** Whether a live triangle has edge ab. */
+  bool
+  hasEdge(int a, int b) const
+  {
+    return traversing(a, b) >= 0 || traversing(b, a) >= 0;
+  }
+  void
+  kill(int t)
+  {
+    dead_[t] = 1;
+    for (const int v : triangles_[t])
+      --uses_[v];
+  }
+  void
+  add(const Triangle& t)
+  {
+    const int id = static_cast<int>(triangles_.size());
+    triangles_.push_back(t);
+    dead_.push_back(0);
+    for (const int v : t) {
+      star_[v].push_back(id);
+      ++uses_[v];
+    }
+  }
+
+private:
+  std::vector<Triangle>& triangles_;
+  std::vector<std::uint8_t> dead_;
+  std::vector<std::vector<int>> star_;
+  std::vector<int> uses_;
+};
+
+using DirectedEdge = std::array<int, 2>;
+
+/** Euler characteristic V - E + F of the triangles \a ids of \a triangles. */
+template <typename Ids>
+long
+eulerCharacteristic(const std::vector<Triangle>& triangles, const Ids& ids)
+{
+  std::vector<int> vertices;
+  std::vector<std::array<int, 2>> edges;
+  for (const int t : ids)
+    for (int c = 0; c < 3; ++c) {
+      vertices.push_back(triangles[t][c]);
+      edges.push_back(edgeKey(triangles[t][c], triangles[t][(c + 1) % 3]));
+    }
+  std::sort(vertices.begin(), vertices.end());
+  std::sort(edges.begin(), edges.end());
+  const long v = std::unique(vertices.begin(), vertices.end()) - vertices.begin();
+  const long e = std::unique(edges.begin(), edges.end()) - edges.begin();
+  return v - e + static_cast<long>(ids.size());
+}
+
+} // namespace
+
 HoleFilling
 fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   const std::vector<double>& spacing,
@@ -168,166 +281,322 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   EdgeIncidences& incidences,
                   std::vector<std::vector<int>>& loops,
                   double reach,
-                  std::size_t max_edges)
+                  std::size_t max_edges,
+                  std::size_t band_per_edge)
 {
   HoleFilling out;
   const std::size_t num_vertices = points.size();
   if (other.empty())
     return out;
-  // As short as the Delaunay patches' edges: where the original Co-cone covers a
-  // true border's hole, it does so with long triangles.
+  // As short as the Delaunay patches' edges: where another mesh covers a true
+  // border's hole, it does so with long triangles.
   const auto short_edge = [&](int a, int b) {
     return withinReach(points, spacing, reach, a, b);
   };
   const EdgeIncidences theirs(other);
   const std::size_t before = triangles.size();
-  std::vector<std::uint8_t> used(num_vertices, 0), taken(other.size(), 0);
-  for (const auto& t : triangles)
-    for (const int v : t)
-      used[v] = 1;
-  // Edges of the patches added here (the incidences are brought up to date once, at
-  // the end).
-  std::set<std::array<int, 2>> added;
-  const auto in_mesh = [&](int a, int b) {
-    return incidences.find(a, b) >= 0 || added.count(edgeKey(a, b)) > 0;
+  LocalMesh mesh(triangles, num_vertices);
+  std::vector<std::uint8_t> taken(other.size(), 0);
+  std::vector<int> in_patch(other.size(), -1), in_band(before, -1);
+  int patch_stamp = -1, band_stamp = -1;
+  std::vector<int> band, patch, stack, blamed;
+  std::vector<DirectedEdge> rim, band_border;
+  std::vector<std::array<int, 2>> rim_keys, patch_edges;
+  std::vector<int> rim_vertices, band_uses, taken_vertices;
+  std::vector<std::size_t> absorbed_sizes; // edges of each loop a patch closes
+  // Blame: the mesh's triangles outside the band at edge ab, or at vertex v.
+  const auto blame_edge = [&](int a, int b) {
+    for (const int t : {mesh.traversing(a, b), mesh.traversing(b, a)})
+      if (t >= 0 && in_band[t] != band_stamp)
+        blamed.push_back(t);
   };
-  std::vector<int> on_loop(num_vertices, -1), in_patch(other.size(), -1);
-  int attempt = -1; // stamps in_patch
-  std::vector<std::vector<int>> open;
-  std::vector<int> patch, stack;
-  std::vector<std::array<int, 2>> loop_edges, patch_edges;
-  std::vector<int> patch_vertices;
-  for (std::size_t l = 0; l < loops.size(); ++l) {
-    auto& loop = loops[l];
+  const auto blame_vertex = [&](int v) {
+    mesh.forStar(v, [&](int t) {
+      if (in_band[t] != band_stamp)
+        blamed.push_back(t);
+    });
+  };
+  bool changed = false;
+  for (const auto& loop : loops) {
     const std::size_t k = loop.size();
-    if (k < 3 || k > max_edges) {
-      open.push_back(std::move(loop));
+    if (k < 3 || k > max_edges)
       continue;
-    }
-    const int id = static_cast<int>(l); // stamps on_loop
-    loop_edges.clear();
-    for (std::size_t i = 0; i < k; ++i) {
-      on_loop[loop[i]] = id;
-      loop_edges.push_back(edgeKey(loop[i], loop[(i + 1) % k]));
-    }
-    std::sort(loop_edges.begin(), loop_edges.end());
-    const auto is_loop_edge = [&](int a, int b) {
-      return std::binary_search(loop_edges.begin(), loop_edges.end(), edgeKey(a, b));
-    };
-    // Seeds: at each loop edge the triangle of the other mesh that traverses it
-    // against the mesh's triangle (or, the other mesh turned over, with it); grown
-    // across the other mesh's inner edges. An edge of the mesh, a border of the other
-    // mesh or a triangle taken already ends the attempt.
-    const auto grow = [&](int flip) {
-      patch.clear();
-      stack.clear();
-      for (std::size_t i = 0; i < k; ++i) {
-        const int a = loop[i], b = loop[(i + 1) % k];
-        const auto e = theirs.find(a, b), mine = incidences.find(a, b);
-        if (e < 0 || mine < 0)
-          return false;
-        const std::size_t at = incidences.first[mine];
-        const Triangle& own = triangles[incidences.triangle[at]];
-        int seed = -1;
-        for (std::size_t j = theirs.first[e]; j < theirs.first[e + 1]; ++j)
-          if ((theirs.forward[j] == incidences.forward[at]) == (flip == 1) &&
-              !sameVertices(other[theirs.triangle[j]], own))
-            seed = theirs.triangle[j];
-        if (seed < 0 || taken[seed])
-          return false;
-        if (in_patch[seed] != attempt) {
-          in_patch[seed] = attempt;
-          stack.push_back(seed);
+    // Still a border of the mesh (an earlier patch may have taken it in)?
+    if ((mesh.traversing(loop[0], loop[1]) >= 0) ==
+        (mesh.traversing(loop[1], loop[0]) >= 0))
+      continue;
+    // The band: the mesh's triangles the other mesh's patch replaces, empty at first
+    // (the patch closes the loop itself). Where the two meshes disagree next to the
+    // hole (an edge the other mesh does not have, a triangle of it crossing an edge
+    // of the mesh, a vertex the mesh still uses), the mesh's triangles there join the
+    // band, up to max_band triangles.
+    ++band_stamp;
+    band.clear();
+    const std::size_t max_band = band_per_edge * k;
+    bool closed = false;
+    while (!closed) {
+      blamed.clear();
+      rim.clear();
+      band_border.clear();
+      absorbed_sizes.assign(1, k);
+      if (band.empty()) {
+        for (std::size_t i = 0; i < k; ++i) {
+          const int a = loop[i], b = loop[(i + 1) % k];
+          rim.push_back(mesh.traversing(a, b) >= 0 ? DirectedEdge{a, b}
+                                                   : DirectedEdge{b, a});
         }
       }
-      while (!stack.empty()) {
-        const int t = stack.back();
-        stack.pop_back();
-        patch.push_back(t);
-        if (patch.size() > PATCH_TRIANGLES_PER_EDGE * k)
-          return false;
-        for (int c = 0; c < 3; ++c) {
-          const int u = other[t][c], v = other[t][(c + 1) % 3];
-          if (is_loop_edge(u, v))
+      else {
+        for (const int t : band)
+          for (int c = 0; c < 3; ++c) {
+            const int a = mesh.triangles()[t][c], b = mesh.triangles()[t][(c + 1) % 3];
+            const int across = mesh.traversing(b, a);
+            if (across < 0)
+              band_border.push_back({a, b});
+            else if (in_band[across] != band_stamp)
+              rim.push_back({b, a});
+          }
+        // The band's borders must be whole loops of the mesh: where the mesh's
+        // border goes on outside the band, the triangles along that loop join it.
+        for (const auto& e : band_border) {
+          int at = e[1];
+          for (std::size_t steps = 0; at != e[0] && steps < max_edges; ++steps) {
+            int next = -1;
+            mesh.forStar(at, [&](int t) {
+              for (int c = 0; c < 3; ++c)
+                if (mesh.triangles()[t][c] == at &&
+                    mesh.traversing(mesh.triangles()[t][(c + 1) % 3], at) < 0) {
+                  next = mesh.triangles()[t][(c + 1) % 3];
+                  if (in_band[t] != band_stamp)
+                    blamed.push_back(t);
+                }
+            });
+            if (next < 0)
+              break;
+            at = next;
+          }
+        }
+        // Each loop taken into the band is a cycle of its border edges.
+        std::sort(band_border.begin(), band_border.end());
+        absorbed_sizes.clear();
+        std::vector<std::uint8_t> seen(band_border.size(), 0);
+        for (std::size_t i = 0; i < band_border.size(); ++i) {
+          if (seen[i])
             continue;
-          const auto e = theirs.find(u, v);
-          if (in_mesh(u, v) || theirs.count(e) != 2 || !short_edge(u, v))
-            return false;
-          for (std::size_t j = theirs.first[e]; j < theirs.first[e + 1]; ++j) {
-            const int next = theirs.triangle[j];
-            if (next == t || in_patch[next] == attempt)
-              continue;
-            if (taken[next])
-              return false;
-            in_patch[next] = attempt;
-            stack.push_back(next);
+          absorbed_sizes.push_back(0);
+          for (std::size_t j = i; !seen[j];) {
+            seen[j] = 1;
+            ++absorbed_sizes.back();
+            const auto next = std::lower_bound(
+                band_border.begin(),
+                band_border.end(),
+                DirectedEdge{band_border[j][1], std::numeric_limits<int>::min()});
+            if (next == band_border.end() || (*next)[0] != band_border[j][1])
+              break;
+            j = static_cast<std::size_t>(next - band_border.begin());
           }
         }
       }
-      return true;
-    };
-    int flip = 0;
-    ++attempt;
-    bool ok = grow(flip);
-    if (!ok) {
-      flip = 1;
-      ++attempt;
-      ok = grow(flip);
-    }
-    // A disk bounded by the loop whose inner vertices are free: Euler characteristic
-    // 1, every loop edge in it once.
-    if (ok) {
-      patch_edges.clear();
-      patch_vertices.clear();
-      for (const int t : patch)
-        for (int c = 0; c < 3; ++c) {
-          const int u = other[t][c];
-          patch_vertices.push_back(u);
-          patch_edges.push_back(edgeKey(u, other[t][(c + 1) % 3]));
-          ok = ok && (on_loop[u] == id || !used[u]);
+      // The rim: cycles that leave each vertex once (else the rim pinches there).
+      std::sort(rim.begin(), rim.end());
+      for (std::size_t i = 1; i < rim.size(); ++i)
+        if (rim[i][0] == rim[i - 1][0])
+          blame_vertex(rim[i][0]);
+      rim_keys.clear();
+      rim_vertices.clear();
+      for (const auto& e : rim) {
+        rim_keys.push_back(edgeKey(e[0], e[1]));
+        rim_vertices.push_back(e[0]);
+      }
+      std::sort(rim_keys.begin(), rim_keys.end());
+      std::sort(rim_vertices.begin(), rim_vertices.end());
+      const auto on_rim = [&](int a, int b) {
+        return std::binary_search(rim_keys.begin(), rim_keys.end(), edgeKey(a, b));
+      };
+      // A vertex is free for the patch if no triangle outside the band uses it.
+      band_uses.clear();
+      for (const int t : band)
+        for (const int v : mesh.triangles()[t])
+          band_uses.push_back(v);
+      std::sort(band_uses.begin(), band_uses.end());
+      const auto free_vertex = [&](int v) {
+        const auto range = std::equal_range(band_uses.begin(), band_uses.end(), v);
+        return mesh.uses(v) == range.second - range.first;
+      };
+      // The other mesh's orientation against the mesh's: the triangles both have,
+      // next to the rim, vote.
+      int same = 0, reversed = 0;
+      for (const auto& e : rim) {
+        const int t = mesh.traversing(e[0], e[1]);
+        const auto j0 = theirs.find(e[0], e[1]);
+        if (j0 < 0)
+          continue;
+        for (std::size_t j = theirs.first[j0]; j < theirs.first[j0 + 1]; ++j)
+          if (sameVertices(other[theirs.triangle[j]], mesh.triangles()[t]))
+            ++(theirs.forward[j] == (e[0] < e[1]) ? same : reversed);
+      }
+      // Seeds: at each rim edge the other mesh's triangle on the side away from the
+      // mesh; grown across the other mesh's inner edges. A border of the other mesh,
+      // an edge longer than the reach or a triangle taken already ends the attempt.
+      const auto grow = [&](int flip) {
+        ++patch_stamp;
+        taken_vertices.clear();
+        patch.clear();
+        stack.clear();
+        for (const auto& e : rim) {
+          const auto j0 = theirs.find(e[0], e[1]);
+          int seed = -1;
+          if (j0 >= 0)
+            for (std::size_t j = theirs.first[j0]; j < theirs.first[j0 + 1]; ++j)
+              if ((theirs.forward[j] == (e[0] < e[1])) == (flip == 1))
+                seed = theirs.triangle[j];
+          if (seed < 0) {
+            blame_edge(e[0], e[1]);
+            continue;
+          }
+          if (taken[seed])
+            return false;
+          if (in_patch[seed] != patch_stamp) {
+            in_patch[seed] = patch_stamp;
+            stack.push_back(seed);
+          }
         }
-      std::sort(patch_vertices.begin(), patch_vertices.end());
-      patch_vertices.erase(std::unique(patch_vertices.begin(), patch_vertices.end()),
-                           patch_vertices.end());
+        // A rim of edges both meshes have first: grown from a rim with gaps, the
+        // patch would leak through them.
+        if (!blamed.empty())
+          return true;
+        while (!stack.empty()) {
+          const int t = stack.back();
+          stack.pop_back();
+          patch.push_back(t);
+          if (patch.size() > PATCH_TRIANGLES_PER_EDGE * rim.size())
+            return false;
+          for (int c = 0; c < 3; ++c) {
+            const int u = other[t][c], v = other[t][(c + 1) % 3];
+            if (!std::binary_search(rim_vertices.begin(), rim_vertices.end(), u) &&
+                !free_vertex(u))
+              taken_vertices.push_back(u);
+            if (on_rim(u, v))
+              continue;
+            const auto e = theirs.find(u, v);
+            if (theirs.count(e) != 2 || !short_edge(u, v))
+              return false;
+            // The patch does not cross the mesh: where it would, the mesh's triangles
+            // there are to join the band.
+            const std::size_t blamed_before = blamed.size();
+            blame_edge(u, v);
+            if (blamed.size() > blamed_before)
+              continue;
+            for (std::size_t j = theirs.first[e]; j < theirs.first[e + 1]; ++j) {
+              const int next = theirs.triangle[j];
+              if (next == t || in_patch[next] == patch_stamp)
+                continue;
+              if (taken[next])
+                return false;
+              in_patch[next] = patch_stamp;
+              stack.push_back(next);
+            }
+          }
+        }
+        return true;
+      };
+      // Where the meshes disagree the band widens, and the patch is sought again.
+      const auto widen = [&]() {
+        if (band.size() >= max_band)
+          return false;
+        std::sort(blamed.begin(), blamed.end());
+        blamed.erase(std::unique(blamed.begin(), blamed.end()), blamed.end());
+        for (const int t : blamed) {
+          in_band[t] = band_stamp;
+          band.push_back(t);
+        }
+        return true;
+      };
+      if (!blamed.empty()) {
+        if (!widen())
+          break;
+        continue;
+      }
+      int flip = reversed > same ? 1 : 0;
+      bool ok = grow(flip);
+      if (!ok && same == reversed && blamed.empty()) {
+        flip = 1 - flip;
+        ok = grow(flip);
+      }
+      // A vertex the patch would share with the mesh outside the band: where no
+      // edge says where they overlap, the mesh's triangles at it join the band.
+      if (ok && blamed.empty())
+        for (const int u : taken_vertices)
+          blame_vertex(u);
+      if (ok && !blamed.empty()) {
+        if (!widen())
+          break;
+        continue;
+      }
+      if (!ok)
+        break;
+      // A patch bounded by the rim that stands for the band with its holes capped:
+      // the same Euler characteristic, so the genus stays.
+      patch_edges.clear();
+      for (const int t : patch)
+        for (int c = 0; c < 3; ++c)
+          patch_edges.push_back(edgeKey(other[t][c], other[t][(c + 1) % 3]));
       std::sort(patch_edges.begin(), patch_edges.end());
       std::size_t border = 0;
-      for (std::size_t i = 0; i < patch_edges.size();) {
+      for (std::size_t i = 0; i < patch_edges.size() && ok;) {
         std::size_t j = i;
         while (j < patch_edges.size() && patch_edges[j] == patch_edges[i])
           ++j;
         border += j - i == 1;
-        ok = ok && (j - i == 1) == is_loop_edge(patch_edges[i][0], patch_edges[i][1]);
+        ok = (j - i == 1) == on_rim(patch_edges[i][0], patch_edges[i][1]);
         i = j;
       }
-      patch_edges.erase(std::unique(patch_edges.begin(), patch_edges.end()),
-                        patch_edges.end());
-      ok = ok && border == k &&
-           static_cast<long>(patch_vertices.size()) -
-                   static_cast<long>(patch_edges.size()) +
-                   static_cast<long>(patch.size()) ==
-               1;
-    }
-    if (!ok) {
-      open.push_back(std::move(loop));
-      continue;
-    }
-    std::sort(patch.begin(), patch.end());
-    for (const int t : patch) {
-      taken[t] = 1;
-      Triangle added_triangle = other[t];
-      if (flip == 1)
-        std::swap(added_triangle[1], added_triangle[2]);
-      triangles.push_back(added_triangle);
-      for (int c = 0; c < 3; ++c) {
-        used[added_triangle[c]] = 1;
-        added.insert(edgeKey(added_triangle[c], added_triangle[(c + 1) % 3]));
+      ok = ok && border == rim.size() &&
+           eulerCharacteristic(other, patch) ==
+               eulerCharacteristic(mesh.triangles(), band) +
+                   static_cast<long>(absorbed_sizes.size());
+      if (!ok)
+        break;
+      for (const int t : band)
+        mesh.kill(t);
+      std::sort(patch.begin(), patch.end());
+      for (const int t : patch) {
+        taken[t] = 1;
+        Triangle added_triangle = other[t];
+        if (flip == 1)
+          std::swap(added_triangle[1], added_triangle[2]);
+        mesh.add(added_triangle);
       }
+      in_band.resize(mesh.triangles().size(), -1);
+      out.holes += absorbed_sizes.size();
+      out.triangles += patch.size();
+      out.sizes.insert(out.sizes.end(), absorbed_sizes.begin(), absorbed_sizes.end());
+      changed = true;
+      closed = true;
     }
-    ++out.holes;
-    out.triangles += patch.size();
-    out.sizes.push_back(k);
   }
-  loops = std::move(open);
+  if (changed) {
+    // Out with the triangles taken out, in with the patches.
+    std::vector<std::uint8_t> dropped(mesh.dead().begin(),
+                                      mesh.dead().begin() + before);
+    incidences.remove(dropped);
+    std::vector<Triangle> kept;
+    kept.reserve(triangles.size());
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      if (!mesh.dead()[t])
+        kept.push_back(triangles[t]);
+    std::size_t survivors = 0;
+    for (std::size_t t = 0; t < before; ++t)
+      survivors += !mesh.dead()[t];
+    triangles = std::move(kept);
+    incidences.add(triangles, survivors);
+    loops = boundaryLoops(incidences, num_vertices);
+  }
+  std::vector<std::uint8_t> used(num_vertices, 0);
+  for (const auto& t : triangles)
+    for (const int v : t)
+      used[v] = 1;
+  const std::size_t after_patches = triangles.size();
 
   // The closed components of the other mesh over free vertices, as they are.
   std::vector<int> component(other.size(), -1);
@@ -359,8 +628,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       triangles.push_back(other[t]);
     out.triangles += patch.size();
   }
-  if (triangles.size() > before)
-    incidences.add(triangles, before);
+  if (triangles.size() > after_patches)
+    incidences.add(triangles, after_patches);
   return out;
 }
 

@@ -97,6 +97,18 @@ plainCoconeMesh(const std::vector<Eigen::Vector3d>& points,
   return walkCandidates(points, candidates, none, threads, scratch).triangles;
 }
 
+/** Rings of co-cone and mesh triangles around the open parts that the original
+ * Co-cone's mesh is made over. */
+constexpr int PLAIN_COCONE_RINGS = 2;
+/** The same for the advancing front: it grows from the most plausible triangle
+ * inwards, and at the region's edge it has too little around to judge (on the
+ * shared closed meshes 3 rings closed one loop fewer than 6, 10 none more). */
+constexpr int ADVANCING_FRONT_RINGS = 6;
+/** The band of the mesh's triangles a patch from the advancing front may replace
+ * around a hole, per loop edge (on the shared closed meshes 6 and 12 closed no
+ * loop more than 3). */
+constexpr std::size_t BAND_PER_LOOP_EDGE = 3;
+
 /** Stages 4-7 and the repair: the oriented manifold mesh over vertex ids. */
 void
 reconstruct(Triangulation& dt,
@@ -158,39 +170,54 @@ reconstruct(Triangulation& dt,
     result.filled_hole_sizes = filled.sizes;
     // What the Delaunay patches leave (loops, points in no triangle) the original
     // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
-    // coarsely for the flatness test. Only there, and two rings around, does that
-    // mesh need making.
-    const std::size_t n = dt.points.size();
-    std::vector<std::uint8_t> region(n, 1);
-    for (const auto& t : result.triangles)
-      for (const int v : t)
-        region[v] = 0;
-    for (const auto& loop : result.border_loops)
-      if (loop.size() <= parameters.max_hole_edges)
-        for (const int v : loop)
-          region[v] = 1;
-    if (std::find(region.begin(), region.end(), 1) != region.end()) {
-      for (int ring = 0; ring < 2; ++ring) {
+    // coarsely for the flatness test. What those leave, the advancing front's may:
+    // the vertex density changing faster than the co-cones follow. Only there, and
+    // a few rings around, does either mesh need making.
+    const auto open_region = [&](int rings, bool free_points) {
+      std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
+      for (const auto& t : result.triangles)
+        for (const int v : t)
+          region[v] = 0;
+      for (const auto& loop : result.border_loops)
+        if (loop.size() <= parameters.max_hole_edges)
+          for (const int v : loop)
+            region[v] = 1;
+      if (std::find(region.begin(), region.end(), 1) == region.end())
+        return std::vector<std::uint8_t>();
+      for (int ring = 0; ring < rings; ++ring) {
         std::vector<std::uint8_t> grown = region;
         for (const auto& t : cells.triangles)
           if (region[t.v[0]] || region[t.v[1]] || region[t.v[2]])
             grown[t.v[0]] = grown[t.v[1]] = grown[t.v[2]] = 1;
+        for (const auto& t : result.triangles)
+          if (region[t[0]] || region[t[1]] || region[t[2]])
+            grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
         region = std::move(grown);
       }
-      const HoleFilling plain =
-          fillHolesFromMesh(dt.points,
-                            spacing,
-                            plainCoconeMesh(dt.points, cells, region, threads),
-                            result.triangles,
-                            incidences,
-                            result.border_loops,
-                            parameters.hole_reach,
-                            parameters.max_hole_edges);
-      counts.holes_filled += plain.holes;
-      counts.hole_triangles += plain.triangles;
+      return region;
+    };
+    const auto fill_from = [&](const std::vector<Triangle>& other,
+                               std::size_t band_per_edge) {
+      const HoleFilling patched = fillHolesFromMesh(dt.points,
+                                                    spacing,
+                                                    other,
+                                                    result.triangles,
+                                                    incidences,
+                                                    result.border_loops,
+                                                    parameters.hole_reach,
+                                                    parameters.max_hole_edges,
+                                                    band_per_edge);
+      counts.holes_filled += patched.holes;
+      counts.hole_triangles += patched.triangles;
       result.filled_hole_sizes.insert(
-          result.filled_hole_sizes.end(), plain.sizes.begin(), plain.sizes.end());
-    }
+          result.filled_hole_sizes.end(), patched.sizes.begin(), patched.sizes.end());
+    };
+    std::vector<std::uint8_t> region = open_region(PLAIN_COCONE_RINGS, true);
+    if (!region.empty())
+      fill_from(plainCoconeMesh(dt.points, cells, region, threads), 0);
+    region = open_region(ADVANCING_FRONT_RINGS, false);
+    if (!region.empty())
+      fill_from(advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE);
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

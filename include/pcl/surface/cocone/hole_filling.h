@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace pcl {
@@ -68,24 +69,37 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
  * another mesh of the same vertices has there: the original Co-cone's, every vertex
  * choosing (the flatness test flags every point of a part sampled too coarsely for
  * it, a tube with a few samples around, so the boundary-aware mesh has nothing
- * there, while the Co-cone triangles still make the surface).
+ * there, while the Co-cone triangles still make the surface), or the advancing
+ * front's (advancingFrontMesh()).
  *
  * A loop is closed by the triangles of \a other reached from its edges, on the side
  * away from the mesh, without crossing an edge of the mesh or a border of
  * \a other: they must make a disk whose border is the loop and whose inner
  * vertices no triangle of the mesh uses, and face as the mesh does (\a other turned
  * over if it faces the other way), every new edge at most \a reach local spacings
- * long as in fillUndersampledHoles() (where the original Co-cone covers a true
- * border's opening, it does so with long triangles). A closed component of \a other
- * with such edges, none of whose vertices the mesh uses, is added as it is.
+ * long as in fillUndersampledHoles() (where another mesh covers a true border's
+ * opening, it does so with long triangles).
+ *
+ * Where the two meshes disagree next to the hole (a loop edge \a other does not
+ * have, a triangle of \a other that would cross an edge of the mesh or use a vertex
+ * the mesh uses), the mesh's triangles there join a band around the hole, at most
+ * \a band_per_edge per loop edge, and the patch is sought on the band's rim
+ * instead: it replaces the band if the band with the holes it holds capped has the
+ * patch's Euler characteristic (the genus stays; the mesh's loops the band takes
+ * in are closed with it), the rim leaves each of its vertices once, and every new
+ * edge is within the reach. A closed component of \a other with such edges, none
+ * of whose vertices the mesh uses, is added as it is.
  * \param[in] points the vertex positions
  * \param[in] spacing per vertex its local spacing (localSpacing())
  * \param[in] other an oriented manifold mesh of the same vertices
- * \param[in,out] triangles the oriented manifold mesh; the patches are appended
+ * \param[in,out] triangles the oriented manifold mesh; the patches are appended,
+ *                 the bands taken out (the others keep their order)
  * \param[in,out] incidences the mesh's edge incidences, kept up to date
  * \param[in,out] loops the mesh's border loops; the closed ones are taken out
  * \param[in] reach the longest new edge allowed, in local spacings
  * \param[in] max_edges loops longer than this are left open
+ * \param[in] band_per_edge the largest band, in triangles per loop edge; 0: only
+ *            patches bounded by the loop itself
  */
 HoleFilling
 fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
@@ -95,7 +109,22 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   EdgeIncidences& incidences,
                   std::vector<std::vector<int>>& loops,
                   double reach,
-                  std::size_t max_edges);
+                  std::size_t max_edges,
+                  std::size_t band_per_edge = 0);
+
+/** \brief CGAL's advancing front reconstruction (Cohen-Steiner and Da; CGAL's
+ * default plausibility: radius ratio bound 5, beta 0.52) of the points \a region
+ * marks, made an oriented manifold by repairManifold(); the triangles index
+ * \a points.
+ *
+ * Where the sampling is too coarse for the co-cones (a thin part, a crease, the
+ * vertex density changing several times over a few spacings), the advancing
+ * front still grows triangles as large as their neighbours': a patch source for
+ * fillHolesFromMesh(). */
+std::vector<Triangle>
+advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<std::uint8_t>& region,
+                   int threads = 1);
 
 } // namespace cocone
 } // namespace pcl
