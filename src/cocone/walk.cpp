@@ -5,12 +5,16 @@
 
 #include <pcl/surface/cocone/walk.h>
 
+#include <CGAL/Exact_rational.h>
+#include <CGAL/Interval_nt.h>
+
 #include <Eigen/Geometry>
 
 #include "edge_sort.h"
 #include "parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -84,6 +88,314 @@ neighborAcross(const TriangleComplex& complex,
   return best;
 }
 
+/** The present triangle of vertices \a a < \a b < \a c, or -1. */
+int
+presentTriangle(const TriangleComplex& complex,
+                const std::vector<std::uint8_t>& present,
+                int a,
+                int b,
+                int c)
+{
+  for (std::size_t i = complex.vertexBegin(a); i < complex.vertexEnd(a); ++i) {
+    const int t = complex.vertexTriangle(i);
+    const auto& v = complex.triangle(t);
+    if (v[1] == b && v[2] == c)
+      return present[t] ? t : -1;
+  }
+  return -1;
+}
+
+/** |pq|^2 - |rs|^2 in the number type NT. */
+template <typename NT>
+NT
+squaredLengthDifference(const Eigen::Vector3d& p,
+                        const Eigen::Vector3d& q,
+                        const Eigen::Vector3d& r,
+                        const Eigen::Vector3d& s)
+{
+  NT d(0);
+  for (int k = 0; k < 3; ++k) {
+    const NT u = NT(p[k]) - NT(q[k]), w = NT(r[k]) - NT(s[k]);
+    d = d + u * u - w * w;
+  }
+  return d;
+}
+
+/** The sign of |pq|^2 - |rs|^2, exactly: intervals, then rationals if they do not
+ * tell. */
+int
+compareSquaredLengths(const Eigen::Vector3d& p,
+                      const Eigen::Vector3d& q,
+                      const Eigen::Vector3d& r,
+                      const Eigen::Vector3d& s)
+{
+  {
+    CGAL::Protect_FPU_rounding<true> protect;
+    const auto d = squaredLengthDifference<CGAL::Interval_nt_advanced>(p, q, r, s);
+    if (d.inf() > 0.0)
+      return 1;
+    if (d.sup() < 0.0)
+      return -1;
+  }
+  return CGAL::sign(squaredLengthDifference<CGAL::Exact_rational>(p, q, r, s));
+}
+
+/** The most tetrahedra of a cluster resolveFlatTetrahedra() decides (clusters of
+ * random samples have one to three). */
+constexpr std::size_t MAXIMUM_CLUSTER = 16;
+
+/** Flat tetrahedra: where four nearly cocircular points make a Delaunay tetrahedron
+ * all four of whose faces are present, the surface through them is one of two pairs
+ * of its faces, and the walk keeps the pair on the side its orientation faces: the
+ * orientation of each walk's seed, i.e. the caller's order of the points, would
+ * decide (mirroring a cloud changed 3 to 4 % of the triangles of one piece on random
+ * samples). Decided here instead, once and without orientation.
+ *
+ * More nearly cospherical points make a cluster of such tetrahedra, joined by shared
+ * faces. The faces of one tetrahedron only (the hull) close around the cluster; the
+ * surface enters through the hull edges that hold a present triangle outside the
+ * cluster (the loop). A cluster qualifies when the loop cuts the hull into two
+ * pieces, each of which spans the loop: the two triangulations of the flat polygon,
+ * one on either side (for one tetrahedron, whose sides may lie on the sampled
+ * surface's border: the one pair of opposite edges that hold nothing outside are
+ * its diagonals, the other four edges the loop). The piece kept is the one whose
+ * longest inner edge is shorter, lengths compared exactly (for one tetrahedron: the
+ * pair about the shorter diagonal; on a tie, the piece without an inner edge at the
+ * lexicographically smallest point): a rule of the points alone, which a tile and the
+ * whole cloud, a cloud and its mirror image apply alike. The other piece and the faces
+ * between two tetrahedra are taken out of \a present. \return the number of clusters
+ * resolved */
+std::size_t
+resolveFlatTetrahedra(const TriangleComplex& complex,
+                      std::vector<std::uint8_t>& present,
+                      int threads)
+{
+  const auto num_edges = static_cast<std::ptrdiff_t>(complex.numEdges());
+  const auto presentAt = [&](int e) {
+    int count = 0;
+    for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i)
+      count += present[complex.edgeTriangle(i)];
+    return count;
+  };
+  // Every tetrahedron all of whose faces are present, found from the edges of
+  // three or more present triangles, as its four faces.
+  std::vector<std::array<int, 4>> found;
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<std::array<int, 4>> mine;
+#pragma omp for schedule(dynamic, 4096) nowait
+    for (std::ptrdiff_t e = 0; e < num_edges; ++e) {
+      if (complex.edgeEnd(e) - complex.edgeBegin(e) < 3 ||
+          presentAt(static_cast<int>(e)) < 3)
+        continue;
+      const auto& edge = complex.edge(static_cast<int>(e));
+      const int a = edge[0], b = edge[1];
+      for (std::size_t i = complex.edgeBegin(e); i < complex.edgeEnd(e); ++i) {
+        const int t1 = complex.edgeTriangle(i);
+        if (!present[t1])
+          continue;
+        const auto& v1 = complex.triangle(t1);
+        const int c1 = v1[0] + v1[1] + v1[2] - a - b;
+        for (std::size_t j = i + 1; j < complex.edgeEnd(e); ++j) {
+          const int t2 = complex.edgeTriangle(j);
+          if (!present[t2])
+            continue;
+          const auto& v2 = complex.triangle(t2);
+          const int c2 = v2[0] + v2[1] + v2[2] - a - b;
+          const int c = std::min(c1, c2), d = std::max(c1, c2);
+          const int t3 =
+              presentTriangle(complex, present, std::min(a, c), std::max(a, c), d);
+          const int t4 = t3 < 0
+                             ? -1
+                             : presentTriangle(
+                                   complex, present, std::min(b, c), std::max(b, c), d);
+          if (t4 < 0)
+            continue;
+          std::array<int, 4> faces{t1, t2, t3, t4};
+          std::sort(faces.begin(), faces.end());
+          mine.push_back(faces);
+        }
+      }
+    }
+#pragma omp critical
+    found.insert(found.end(), mine.begin(), mine.end());
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  if (found.empty())
+    return 0;
+
+  // Clusters: tetrahedra joined by shared faces.
+  const int tets = static_cast<int>(found.size());
+  std::vector<std::pair<int, int>> face_tet; // (face, tetrahedron)
+  for (int k = 0; k < tets; ++k)
+    for (const int t : found[k])
+      face_tet.emplace_back(t, k);
+  std::sort(face_tet.begin(), face_tet.end());
+  std::vector<int> root(tets);
+  std::iota(root.begin(), root.end(), 0);
+  const auto find = [&](int k) {
+    while (root[k] != k)
+      k = root[k] = root[root[k]];
+    return k;
+  };
+  for (std::size_t i = 1; i < face_tet.size(); ++i)
+    if (face_tet[i].first == face_tet[i - 1].first) {
+      const int a = find(face_tet[i].second), b = find(face_tet[i - 1].second);
+      root[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<std::pair<int, int>> members; // (cluster, tetrahedron)
+  for (int k = 0; k < tets; ++k)
+    members.emplace_back(find(k), k);
+  std::sort(members.begin(), members.end());
+
+  const auto& P = complex.points();
+  const auto length_less = [&](int e, int f) {
+    const auto &a = complex.edge(e), &b = complex.edge(f);
+    return compareSquaredLengths(P[a[0]], P[a[1]], P[b[0]], P[b[1]]) < 0;
+  };
+  const auto lex_less = [&](int u, int w) {
+    return std::lexicographical_compare(
+        P[u].data(), P[u].data() + 3, P[w].data(), P[w].data() + 3);
+  };
+  std::vector<int> removed, faces, hull, edges, piece;
+  std::size_t resolved = 0;
+  for (std::size_t begin = 0, end; begin < members.size(); begin = end) {
+    for (end = begin;
+         end < members.size() && members[end].first == members[begin].first;
+         ++end) {
+    }
+    if (end - begin > MAXIMUM_CLUSTER)
+      continue; // many cospherical points: left to the walk
+    faces.clear();
+    for (std::size_t i = begin; i < end; ++i)
+      for (const int t : found[members[i].second])
+        faces.push_back(t);
+    std::sort(faces.begin(), faces.end());
+    // The hull: the faces of one tetrahedron; a face of three is no Delaunay cluster.
+    hull.clear();
+    bool ok = true;
+    for (std::size_t i = 0, j; i < faces.size(); i = j) {
+      for (j = i; j < faces.size() && faces[j] == faces[i]; ++j) {
+      }
+      ok = ok && j - i <= 2;
+      if (j - i == 1)
+        hull.push_back(faces[i]);
+    }
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    const auto in_cluster = [&](int t) {
+      return std::binary_search(faces.begin(), faces.end(), t);
+    };
+    // Per hull edge: the loop if a present triangle outside the cluster holds it;
+    // otherwise it joins its two hull faces into one piece.
+    const int h = static_cast<int>(hull.size());
+    piece.assign(h, -1);
+    edges.clear();
+    for (const int t : hull)
+      for (const int e : complex.triangleEdges(t))
+        edges.push_back(e);
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<std::array<int, 2>> at(edges.size(), {-1, -1}); // hull faces
+    std::vector<std::uint8_t> loop(edges.size(), 0);
+    for (std::size_t i = 0; ok && i < edges.size(); ++i) {
+      const int e = edges[i];
+      int hull_faces = 0;
+      for (std::size_t k = complex.edgeBegin(e); k < complex.edgeEnd(e); ++k) {
+        const int t = complex.edgeTriangle(k);
+        if (!present[t])
+          continue;
+        if (!in_cluster(t))
+          loop[i] = 1;
+        else if (std::binary_search(hull.begin(), hull.end(), t)) {
+          if (hull_faces < 2)
+            at[i][hull_faces] = static_cast<int>(
+                std::lower_bound(hull.begin(), hull.end(), t) - hull.begin());
+          ++hull_faces;
+        }
+      }
+      ok = hull_faces == 2;
+    }
+    if (!ok || std::find(loop.begin(), loop.end(), 1) == loop.end())
+      continue;
+    if (end - begin == 1) {
+      // One tetrahedron: its sides may lie on the sampled surface's border and hold
+      // nothing outside. Its diagonals are the one pair of opposite edges that hold
+      // nothing outside; the other four edges are the loop.
+      int pairs = 0;
+      std::array<std::size_t, 2> diagonals{};
+      for (std::size_t i = 0; i < edges.size(); ++i)
+        for (std::size_t j = i + 1; j < edges.size(); ++j) {
+          const auto &x = complex.edge(edges[i]), &y = complex.edge(edges[j]);
+          if (!loop[i] && !loop[j] && x[0] != y[0] && x[0] != y[1] && x[1] != y[0] &&
+              x[1] != y[1]) {
+            diagonals = {i, j};
+            ++pairs;
+          }
+        }
+      if (pairs != 1)
+        continue;
+      std::fill(loop.begin(), loop.end(), 1);
+      loop[diagonals[0]] = loop[diagonals[1]] = 0;
+    }
+    // The pieces: hull faces joined across the edges off the loop.
+    int pieces = 0;
+    for (int f = 0; f < h; ++f) {
+      if (piece[f] >= 0)
+        continue;
+      piece[f] = pieces;
+      for (bool grown = true; grown;) {
+        grown = false;
+        for (std::size_t i = 0; i < edges.size(); ++i)
+          if (!loop[i] && (piece[at[i][0]] == pieces) != (piece[at[i][1]] == pieces)) {
+            piece[at[i][0]] = piece[at[i][1]] = pieces;
+            grown = true;
+          }
+      }
+      ++pieces;
+    }
+    // Two pieces, each spanning the loop.
+    ok = pieces == 2;
+    for (std::size_t i = 0; ok && i < edges.size(); ++i)
+      ok = !loop[i] || piece[at[i][0]] != piece[at[i][1]];
+    if (!ok)
+      continue;
+    // Per piece its longest inner edge, and whether one is at the lexicographically
+    // smallest vertex of the cluster.
+    int smallest = complex.triangle(hull[0])[0];
+    for (const int t : hull)
+      for (const int v : complex.triangle(t))
+        if (lex_less(v, smallest))
+          smallest = v;
+    std::array<int, 2> longest{-1, -1};
+    std::array<bool, 2> at_smallest{false, false};
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      if (loop[i])
+        continue;
+      const int k = piece[at[i][0]];
+      if (longest[k] < 0 || length_less(longest[k], edges[i]))
+        longest[k] = edges[i];
+      const auto& ends = complex.edge(edges[i]);
+      at_smallest[k] = at_smallest[k] || ends[0] == smallest || ends[1] == smallest;
+    }
+    if (longest[0] < 0 || longest[1] < 0)
+      continue;
+    int drop = length_less(longest[1], longest[0])   ? 0
+               : length_less(longest[0], longest[1]) ? 1
+                                                     : (at_smallest[1] ? 1 : 0);
+    for (int f = 0; f < h; ++f)
+      if (piece[f] == drop)
+        removed.push_back(hull[f]);
+    for (const int t : faces)
+      if (!std::binary_search(hull.begin(), hull.end(), t))
+        removed.push_back(t);
+    ++resolved;
+  }
+  for (const int t : removed)
+    present[t] = 0;
+  return resolved;
+}
+
 } // namespace
 
 int
@@ -101,12 +413,14 @@ surfaceNeighbor(const TriangleComplex& complex,
 
 WalkResult
 walk(const TriangleComplex& complex,
-     const std::vector<std::uint8_t>& present,
+     const std::vector<std::uint8_t>& pruned,
      const std::vector<std::uint8_t>& boundary,
      int threads)
 {
   const int m = static_cast<int>(complex.numTriangles());
   WalkResult out;
+  std::vector<std::uint8_t> present = pruned;
+  out.flat_clusters = resolveFlatTetrahedra(complex, present, threads);
 
   // Connected components of the present triangles (through shared edges), by a
   // union-find over the edges in parallel: a set's root is its lowest triangle.

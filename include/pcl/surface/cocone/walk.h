@@ -26,6 +26,9 @@ struct WalkResult {
   std::size_t conflicts = 0;
   /** Extra walks started from triangles the first walks left with no vertex used. */
   std::size_t reseeds = 0;
+  /** Clusters of flat tetrahedra whose side was chosen before the walk, whatever
+   * its orientation (see walk()). */
+  std::size_t flat_clusters = 0;
 };
 
 /** \brief SURFACENEIGHBOR: the triangle to continue with across edge x->y of the
@@ -51,14 +54,22 @@ surfaceNeighbor(const TriangleComplex& complex,
  * again from every present triangle whose vertices no walk has reached (a component
  * joined to another only by stray triangles that the walk does not cross).
  *
+ * Where nearly cospherical points make flat Delaunay tetrahedra all of whose faces
+ * are present, SURFACENEIGHBOR would keep the faces on the side the walk's
+ * orientation faces, an orientation that comes from the seed. The side is chosen
+ * before the walk instead, by a rule of the points alone (the side whose longest
+ * inner edge is shorter, compared exactly), so that the triangles do not depend on
+ * the order or the handedness of the points: a cloud and its mirror image, a tile
+ * and the whole cloud, give the same.
+ *
  * \param[in] complex the candidate triangles
- * \param[in] present per triangle: survived pruning
+ * \param[in] pruned per triangle: survived pruning
  * \param[in] boundary per vertex: B plus the umbrella failures
  * \param[in] threads threads to find the components with (the same walk)
  */
 WalkResult
 walk(const TriangleComplex& complex,
-     const std::vector<std::uint8_t>& present,
+     const std::vector<std::uint8_t>& pruned,
      const std::vector<std::uint8_t>& boundary,
      int threads = 1);
 
