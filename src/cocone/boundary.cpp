@@ -46,7 +46,8 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
              const std::vector<double>& spacing,
              double reach,
              double gap_angle,
-             int threads)
+             int threads,
+             const std::vector<std::uint8_t>& counted)
 {
   const std::size_t n = points.size();
   const auto near = [&](std::size_t p, int q) {
@@ -112,20 +113,32 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
   // vertex (ids follow a space-filling curve): all of them in a cloud of fewer than
   // 2 * MEDIAN_SAMPLE, at least MEDIAN_SAMPLE of them in a larger one.
   constexpr std::size_t MEDIAN_SAMPLE = 65536;
-  const std::size_t stride = std::max<std::size_t>(1, n / MEDIAN_SAMPLE);
-  const auto sampled = static_cast<std::ptrdiff_t>((n + stride - 1) / stride);
+  std::vector<int> median_sample;
+  {
+    const std::size_t m = counted.empty() ? n
+                                          : n - static_cast<std::size_t>(std::count(
+                                                    counted.begin(), counted.end(), 0));
+    const std::size_t stride = std::max<std::size_t>(1, m / MEDIAN_SAMPLE);
+    median_sample.reserve((m + stride - 1) / stride);
+    for (std::size_t p = 0, k = 0; p < n; ++p)
+      if ((counted.empty() || counted[p]) && k++ % stride == 0)
+        median_sample.push_back(static_cast<int>(p));
+  }
+  const auto sampled = static_cast<std::ptrdiff_t>(median_sample.size());
   std::vector<double> g(sampled);
+  std::vector<std::uint8_t> in_sample(n, 0);
 #pragma omp parallel num_threads(threads)
   {
     Scratch scratch;
 #pragma omp for schedule(dynamic, 256)
     for (std::ptrdiff_t i = 0; i < sampled; ++i) {
-      const auto p = static_cast<int>(static_cast<std::size_t>(i) * stride);
+      const int p = median_sample[i];
+      in_sample[p] = 1;
       out.gap[p] = g[i] = gap(p, true, scratch);
     }
   }
   out.angle = gap_angle;
-  if (n > 0) {
+  if (sampled > 0) {
     std::nth_element(g.begin(), g.begin() + sampled / 2, g.end());
     const double irregular = g[sampled / 2] / (50.0 * M_PI / 180.0);
     out.angle = std::max(gap_angle, gap_angle * irregular * irregular);
@@ -137,7 +150,7 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
 #pragma omp for schedule(dynamic, 1024)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(n); ++i) {
       const auto p = static_cast<int>(i);
-      if (static_cast<std::size_t>(i) % stride == 0)
+      if (in_sample[p])
         continue;
       out.gap[p] = gap(p, false, scratch);
       if (out.gap[p] > out.angle)
@@ -157,11 +170,13 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
 }
 
 double
-automaticRatio(const VoronoiCells& cells)
+automaticRatio(const VoronoiCells& cells, const std::vector<std::uint8_t>& counted)
 {
   std::vector<double> r;
   r.reserve(cells.width.size());
   for (std::size_t v = 0; v < cells.width.size(); ++v) {
+    if (!counted.empty() && !counted[v])
+      continue;
     const double q = cells.width[v] / cells.height(v);
     if (std::isfinite(q) && cells.height(v) > 0.0)
       r.push_back(q);

@@ -451,7 +451,8 @@ findOutliers(const std::vector<Eigen::Vector3d>& points,
 NoiseAnalysis
 analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, NEAREST>>& nearest,
-             int threads)
+             int threads,
+             const std::vector<std::uint8_t>& counted)
 {
   const auto n = static_cast<std::ptrdiff_t>(points.size());
   NoiseAnalysis out;
@@ -465,7 +466,15 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
       out.level[p] = static_cast<float>(
           noiseLevel(Jet(points, points[p], nearest[p].data(), k, true)));
   }
-  out.cloud_level = median(out.level);
+  if (counted.empty())
+    out.cloud_level = median(out.level);
+  else {
+    std::vector<float> level;
+    for (std::ptrdiff_t p = 0; p < n; ++p)
+      if (counted[p])
+        level.push_back(out.level[p]);
+    out.cloud_level = median(std::move(level));
+  }
   std::vector<int> all(n);
   for (std::ptrdiff_t p = 0; p < n; ++p)
     all[p] = static_cast<int>(p);
@@ -523,7 +532,8 @@ double
 cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
                 const std::vector<std::array<int, NEAREST>>& nearest,
                 const std::vector<std::uint8_t>& outlier,
-                int threads)
+                int threads,
+                const std::vector<std::uint8_t>& counted)
 {
   const auto samples = static_cast<std::ptrdiff_t>(
       (points.size() + RECHECK_STRIDE - 1) / RECHECK_STRIDE);
@@ -531,7 +541,7 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
 #pragma omp parallel for num_threads(threads) schedule(static, 1024)
   for (std::ptrdiff_t i = 0; i < samples; ++i) {
     const int p = static_cast<int>(i * RECHECK_STRIDE);
-    if (!outlier.empty() && outlier[p])
+    if ((!outlier.empty() && outlier[p]) || (!counted.empty() && !counted[p]))
       continue;
     std::array<int, NEAREST> list;
     int c = 0;

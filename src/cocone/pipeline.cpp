@@ -249,6 +249,22 @@ reconstruct(Triangulation& dt,
   }
 }
 
+/** Per vertex: whether it counts in the cloud's statistics (one of the first
+ * Parameters::statistics_points points is at it); empty: all do. */
+std::vector<std::uint8_t>
+countedVertices(const Parameters& parameters, const Result& result)
+{
+  const std::size_t n = parameters.statistics_points;
+  std::vector<std::uint8_t> counted;
+  if (n == 0 || n >= result.vertex_of_input.size())
+    return counted;
+  counted.assign(result.vertices, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (result.vertex_of_input[i] >= 0)
+      counted[result.vertex_of_input[i]] = 1;
+  return counted;
+}
+
 /** The highest cloud noise level read as noise (about sigma in spacings): noise of
  * one spacing reads 0.87 to 0.90 on the test surfaces, a tube with 7 to 13 samples
  * around its circumference 1.14 to 1.5 (and smoothing would collapse it). */
@@ -269,7 +285,8 @@ handleNoise(Triangulation& dt,
 {
   if (cells.nearest.size() != dt.points.size())
     return false; // no neighbour lists (coplanar points): nothing to read
-  const NoiseAnalysis noise = analyzeNoise(dt.points, cells.nearest, threads);
+  const std::vector<std::uint8_t> counted = countedVertices(parameters, result);
+  const NoiseAnalysis noise = analyzeNoise(dt.points, cells.nearest, threads, counted);
   result.noise_level = noise.cloud_level;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   result.point_noise.assign(result.vertex_of_input.size(), nan);
@@ -289,7 +306,7 @@ handleNoise(Triangulation& dt,
     // Smoothing takes noise out; what it leaves is a surface too coarse or creased
     // for the jets, which smoothing would flatten: then the points stay as they are.
     result.noise_after_smoothing =
-        cloudNoiseLevel(kept, cells.nearest, noise.outlier, threads);
+        cloudNoiseLevel(kept, cells.nearest, noise.outlier, threads, counted);
     result.smoothed =
         result.noise_after_smoothing < SMOOTHED_NOISE_SHARE * noise.cloud_level;
   }
@@ -378,10 +395,16 @@ runStages(std::vector<Eigen::Vector3d>&& points,
       detect && (parameters.spacing_factor > 0.0 || half_disk)
           ? localSpacing(dt.points, cells, threads)
           : std::vector<double>();
+  const std::vector<std::uint8_t> counted = countedVertices(parameters, result);
   HalfDisk test;
   if (half_disk)
-    test = halfDiskTest(
-        dt.points, cells, spacing, parameters.gap_reach, parameters.gap_angle, threads);
+    test = halfDiskTest(dt.points,
+                        cells,
+                        spacing,
+                        parameters.gap_reach,
+                        parameters.gap_angle,
+                        threads,
+                        counted);
   std::vector<std::array<int, VoronoiCells::NEAREST>>().swap(cells.nearest);
   result.timings.boundary = clock.lap();
 
@@ -397,11 +420,13 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   // (its local spacing), infinite for the others; empty without the half-disk test.
   std::vector<double> rim_reach;
   if (detect) {
-    const BoundaryLabels labels = detectBoundary(
-        cells,
-        {parameters.ratio, parameters.normal_angle, parameters.spacing_factor},
-        spacing,
-        threads);
+    const double ratio =
+        parameters.ratio > 0.0 ? parameters.ratio : automaticRatio(cells, counted);
+    const BoundaryLabels labels =
+        detectBoundary(cells,
+                       {ratio, parameters.normal_angle, parameters.spacing_factor},
+                       spacing,
+                       threads);
     result.ratio = labels.ratio;
     for (std::size_t v = 0; v < result.vertices; ++v)
       result.boundary[v] = !labels.interior[v];

@@ -886,7 +886,9 @@ reconstructTile(std::vector<Eigen::Vector3d> points,
                               ids.begin() + static_cast<std::ptrdiff_t>(core_points));
     std::sort(core_ids.begin(), core_ids.end());
 
-    Result r = run(std::move(points), parameters, Stages::RECONSTRUCTION, ids);
+    Parameters core_statistics = parameters; // the core comes first: it alone counts
+    core_statistics.statistics_points = core_points;
+    Result r = run(std::move(points), core_statistics, Stages::RECONSTRUCTION, ids);
     if (!r.error.empty() && r.vertex_of_input.size() != ids.size()) {
       out.error = r.error; // out of memory, no thread: nothing to go on with
       return out;

@@ -75,7 +75,7 @@ struct HalfDisk {
  * where 80 degrees would flag a third of the points. The gap angle used is
  * \a gap_angle times (median gap / 50 degrees)^2 when that is larger; the median is
  * that of all the vertices below 131,072, of a sample of 65,536 to 131,071 spread
- * evenly along the ids (a space-filling curve) above.
+ * evenly along the ids (a space-filling curve) above; of the vertices counted.
  *
  * \param[in] points the triangulation's points
  * \param[in] cells stage 2 output (the poles, the nearest neighbours)
@@ -83,6 +83,8 @@ struct HalfDisk {
  * \param[in] reach neighbours count within reach * s_p
  * \param[in] gap_angle the largest gap (radians) of a point that is not a rim point
  * \param[in] threads number of threads (the result does not depend on it)
+ * \param[in] counted per vertex: counts in the median (e.g. a tile's core, not its
+ *            halo); empty: every vertex
  */
 HalfDisk
 halfDiskTest(const std::vector<Eigen::Vector3d>& points,
@@ -90,15 +92,21 @@ halfDiskTest(const std::vector<Eigen::Vector3d>& points,
              const std::vector<double>& spacing,
              double reach,
              double gap_angle,
-             int threads = 1);
+             int threads = 1,
+             const std::vector<std::uint8_t>& counted = {});
 
 /** \brief The automatic ratio rho = clamp(1 / (2 Q95(w / h)), 0.5, 4).
  *
  * Theory ties rho to the sampling density (rho = 1 / (1.3 epsilon)) and w / h of
  * interior cells is of the order of epsilon: the 95th percentile of w / h over the
- * cloud measures epsilon with room for the few border points. */
+ * cloud measures epsilon with room for the few border points.
+ *
+ * \param[in] cells stage 2 output
+ * \param[in] counted per vertex: counts in the percentile (e.g. a tile's core, not
+ *            its halo); empty: every vertex */
 double
-automaticRatio(const VoronoiCells& cells);
+automaticRatio(const VoronoiCells& cells,
+               const std::vector<std::uint8_t>& counted = {});
 
 /** \brief Per-vertex outcome of stage 3. */
 struct BoundaryLabels {

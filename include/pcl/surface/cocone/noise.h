@@ -29,7 +29,8 @@ struct NoiseAnalysis {
    * spacing (measured on random samples: sigma 0.3, 0.5 and 1 read 0.30, 0.49 and
    * 0.87); clean samples of the test surfaces read below 0.05. */
   std::vector<float> level;
-  /** The noise level of the cloud: the median of level over the points. */
+  /** The noise level of the cloud: the median of level over the points (those
+   * counted, see analyzeNoise()). */
   double cloud_level = 0.0;
   /** Per vertex: an outlier (see analyzeNoise()). */
   std::vector<std::uint8_t> outlier;
@@ -57,11 +58,14 @@ struct NoiseAnalysis {
  * \param[in] points the Delaunay vertices
  * \param[in] nearest their nearest Delaunay neighbours (VoronoiCells::nearest)
  * \param[in] threads threads to compute with (the result does not depend on them)
+ * \param[in] counted per vertex: counts in the cloud's level (e.g. a tile's core,
+ *            not its halo); empty: every vertex
  */
 NoiseAnalysis
 analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
-             int threads = 1);
+             int threads = 1,
+             const std::vector<std::uint8_t>& counted = {});
 
 /** \brief The noise level of the cloud (NoiseAnalysis::cloud_level) read again on
  * other positions of the same points, with the same neighbours, on one point in 4:
@@ -71,12 +75,14 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
  * \param[in] nearest their nearest Delaunay neighbours (VoronoiCells::nearest)
  * \param[in] outlier per vertex: an outlier, left out (empty: none)
  * \param[in] threads threads to compute with (the result does not depend on them)
+ * \param[in] counted per vertex: counts (see analyzeNoise()); empty: every vertex
  */
 double
 cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
                 const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
                 const std::vector<std::uint8_t>& outlier,
-                int threads = 1);
+                int threads = 1,
+                const std::vector<std::uint8_t>& counted = {});
 
 /** \brief The points projected onto local fits (scale space): each point moves onto
  * the quadratic height field (a degree-2 jet, as CGAL's jet_smooth_point_set) fitted

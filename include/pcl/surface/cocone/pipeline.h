@@ -74,6 +74,12 @@ struct Parameters {
   /** Threads for the parallel stages, 0 for all processors; the output does not
    * depend on it. */
   unsigned int threads = 1;
+  /** Only the first this many points passed to run() count in the statistics read
+   * off the whole cloud: the automatic ratio, the median gap of the half-disk test,
+   * the noise level before and after smoothing. 0: every point. A tile of
+   * runTiled() passes its core first and counts it alone, so that its halo, whose
+   * outer points lack neighbours, does not weigh in. */
+  std::size_t statistics_points = 0;
 };
 
 /** \brief Sizes of the intermediate results of stages 4-7. */
