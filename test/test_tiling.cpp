@@ -41,10 +41,11 @@ constexpr std::size_t POINTS = 30000;
 /** 16 tiles of about 1,900 points from 30,000. */
 constexpr std::size_t TILE_POINTS = 3000;
 /** The share of triangles that may differ from one piece, in percent. Measured on
- * these clouds: 0.01 (sphere with holes) to 2.2 (torus); the difference is the
- * walk's choice at flat tetrahedra, which follows each walk's orientation (see
- * runTiled()), not the seams. */
-constexpr double DIFFERING_PERCENT = 4.0;
+ * these clouds: 0.007 (torus), 0.018 (sphere with holes), 0.06 (noisy torus), 0.13
+ * (saddle with a hole: at the sampled surface's border, whose labels depend on
+ * points far along it, see runTiled()); 0.02 to 2.8 before the walk chose the side
+ * of flat tetrahedra by the points alone. */
+constexpr double DIFFERING_PERCENT = 0.25;
 
 /** The monkey saddle with a round hole: two border loops, Euler characteristic 0. */
 Sample
@@ -294,6 +295,31 @@ INSTANTIATE_TEST_SUITE_P(
     Surfaces,
     Tiling,
     ::testing::Values("torus", "saddle_with_hole", "sphere_with_holes", "noisy_torus"));
+
+/** One piece of a cloud and of its mirror image: the same triangles, up to their
+ * orientation. The walk's choice at flat tetrahedra followed its orientation, which
+ * the mirror turns over (3 to 4 % of the triangles differed on these clouds); it
+ * is now a rule of the points alone. */
+TEST(TilingMirror, ACloudAndItsMirrorImageGiveTheSameTriangles)
+{
+  for (const std::string name : {"torus", "saddle_with_hole"}) {
+    const Case& c = reconstructed(name);
+    std::vector<Eigen::Vector3d> mirrored = c.sample.points;
+    for (auto& p : mirrored)
+      p.x() = -p.x();
+    Parameters parameters;
+    parameters.threads = 2;
+    const Result m =
+        pcl::cocone::run(mirrored, parameters, pcl::cocone::Stages::RECONSTRUCTION);
+    ASSERT_TRUE(m.error.empty()) << m.error;
+    const std::size_t d = differing(c.one.polygons, m.polygons);
+    std::printf("[ measured ] %s mirrored: %zu of %zu triangles differ\n",
+                name.c_str(),
+                d,
+                c.one.polygons.size());
+    EXPECT_EQ(d, 0u) << name;
+  }
+}
 
 TEST(TilingDeterminism, SameOutputWithOneAndTwoThreads)
 {
