@@ -88,7 +88,7 @@ neighborAcross(const TriangleComplex& complex,
   return best;
 }
 
-/** The present triangle of vertices \a a < \a b < \a c, or -1. */
+/** The present triangle of vertices \a a, \a b, \a c (any order), or -1. */
 int
 presentTriangle(const TriangleComplex& complex,
                 const std::vector<std::uint8_t>& present,
@@ -96,10 +96,11 @@ presentTriangle(const TriangleComplex& complex,
                 int b,
                 int c)
 {
-  for (std::size_t i = complex.vertexBegin(a); i < complex.vertexEnd(a); ++i) {
+  Triangle v{a, b, c};
+  std::sort(v.begin(), v.end());
+  for (std::size_t i = complex.vertexBegin(v[0]); i < complex.vertexEnd(v[0]); ++i) {
     const int t = complex.vertexTriangle(i);
-    const auto& v = complex.triangle(t);
-    if (v[1] == b && v[2] == c)
+    if (complex.triangle(t) == v)
       return present[t] ? t : -1;
   }
   return -1;
@@ -202,13 +203,8 @@ resolveFlatTetrahedra(const TriangleComplex& complex,
             continue;
           const auto& v2 = complex.triangle(t2);
           const int c2 = v2[0] + v2[1] + v2[2] - a - b;
-          const int c = std::min(c1, c2), d = std::max(c1, c2);
-          const int t3 =
-              presentTriangle(complex, present, std::min(a, c), std::max(a, c), d);
-          const int t4 = t3 < 0
-                             ? -1
-                             : presentTriangle(
-                                   complex, present, std::min(b, c), std::max(b, c), d);
+          const int t3 = presentTriangle(complex, present, a, c1, c2);
+          const int t4 = t3 < 0 ? -1 : presentTriangle(complex, present, b, c1, c2);
           if (t4 < 0)
             continue;
           std::array<int, 4> faces{t1, t2, t3, t4};
