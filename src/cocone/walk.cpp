@@ -145,8 +145,8 @@ compareSquaredLengths(const Eigen::Vector3d& p,
  * random samples have one to three). */
 constexpr std::size_t MAXIMUM_CLUSTER = 16;
 
-/** Flat tetrahedra: where four nearly cocircular points make a Delaunay tetrahedron
- * all four of whose faces are present, the surface through them is one of two pairs
+/** Flat tetrahedra: where four nearly cocircular points make a tetrahedron all four
+ * of whose faces are present, the surface through them is one of two pairs
  * of its faces, and the walk keeps the pair on the side its orientation faces: the
  * orientation of each walk's seed, i.e. the caller's order of the points, would
  * decide (mirroring a cloud changed 3 to 4 % of the triangles of one piece on random
@@ -164,8 +164,9 @@ constexpr std::size_t MAXIMUM_CLUSTER = 16;
  * pair about the shorter diagonal; on a tie, the piece without an inner edge at the
  * lexicographically smallest point): a rule of the points alone, which a tile and the
  * whole cloud, a cloud and its mirror image apply alike. The other piece and the faces
- * between two tetrahedra are taken out of \a present. \return the number of clusters
- * resolved */
+ * between two tetrahedra are taken out of \a present.
+ *
+ * \return the number of clusters resolved */
 std::size_t
 resolveFlatTetrahedra(const TriangleComplex& complex,
                       std::vector<std::uint8_t>& present,
