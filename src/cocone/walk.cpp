@@ -225,6 +225,7 @@ resolveFlatTetrahedra(const TriangleComplex& complex,
   // Clusters: tetrahedra joined by shared faces.
   const int tets = static_cast<int>(found.size());
   std::vector<std::pair<int, int>> face_tet; // (face, tetrahedron)
+  face_tet.reserve(4 * found.size());
   for (int k = 0; k < tets; ++k)
     for (const int t : found[k])
       face_tet.emplace_back(t, k);
@@ -242,6 +243,7 @@ resolveFlatTetrahedra(const TriangleComplex& complex,
       root[std::max(a, b)] = std::min(a, b);
     }
   std::vector<std::pair<int, int>> members; // (cluster, tetrahedron)
+  members.reserve(found.size());
   for (int k = 0; k < tets; ++k)
     members.emplace_back(find(k), k);
   std::sort(members.begin(), members.end());
