@@ -298,14 +298,14 @@ stitchTiles(TilePlan plan,
  * moves the labels of border points (whose gaps are near a half turn) but hardly the
  * triangles. The cloud's own figures would need every tile's cells before any tile
  * labels its points (a second pass over the tiles). The triangles differ at the sampled
- * surface's border: 1M random monkey saddle 0.022 % of the triangles (0.28 % before),
- * 434 of the 442 within 0.005 of its border (the square is 2 wide). On the 250,000
- * points in 8 tiles, 198 triangles differ; 150 with a halo of 32 spacings, 167 with the
- * half-disk test off, 192 with the one-piece gap angle forced on every tile: neither
- * the halo nor the statistics are most of what is left, whose cause is not yet known. A
- * border loop that runs out of a tile's halo is not closed as an undersampled hole by
- * either tile. The topology (Euler characteristic, components, border loops) has been
- * that of one piece throughout.
+ * surface's border: 1M random monkey saddle 0.022 % of the triangles (0.28 % before;
+ * 10M 0.0093 %, 0.072 % before), 434 of the 442 within 0.005 of its border (the square
+ * is 2 wide). On the 250,000 points in 8 tiles, 198 triangles differ; 150 with a halo
+ * of 32 spacings, 167 with the half-disk test off, 192 with the one-piece gap angle
+ * forced on every tile: neither the halo nor the statistics are most of what is left,
+ * whose cause is not yet known. A border loop that runs out of a tile's halo is not
+ * closed as an undersampled hole by either tile. The topology (Euler characteristic,
+ * components, border loops) has been that of one piece throughout.
  *
  * The output does not depend on the number of threads or tiles in flight. A tile
  * that fails for lack of memory fails the run (Result::error); a degenerate tile
