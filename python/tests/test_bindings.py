@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import pcl_cocone
+from samples import torus
 
 GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
 
@@ -246,20 +247,6 @@ def test_tiles():
         pcl_cocone.detect_boundary(points, tile_points=1000)
 
 
-def torus(n, seed=4, noise=0.0):
-    """n random points on the torus of radii 1 and 0.4, evenly spread by area."""
-    rng = np.random.default_rng(seed)
-    u, v = np.empty(0), np.empty(0)
-    while len(u) < n:
-        a, b = rng.uniform(0.0, 2.0 * math.pi, (2, n))
-        keep = rng.uniform(0.0, 1.4, n) < 1.0 + 0.4 * np.cos(b)
-        u, v = np.concatenate((u, a[keep])), np.concatenate((v, b[keep]))
-    u, v = u[:n], v[:n]
-    r = 1.0 + 0.4 * np.cos(v)
-    points = np.column_stack((r * np.cos(u), r * np.sin(u), 0.4 * np.sin(v)))
-    return points + rng.normal(0.0, noise, points.shape)
-
-
 def same_result(a, b):
     assert np.array_equal(a.triangles, b.triangles)
     assert np.array_equal(a.normals, b.normals, equal_nan=True)
@@ -272,7 +259,7 @@ def same_result(a, b):
 
 
 def test_tile_phases_by_hand_equal_reconstruct_with_tiles():
-    points = torus(12000, noise=1e-3)
+    points = torus(12000, 4, noise=1e-3)
     points[5] = np.nan  # in no tile
     parameters = {"tile_points": 2000, "threads": 2}
     whole = pcl_cocone.reconstruct(points, **parameters)

@@ -5,7 +5,6 @@ writes, also when a worker is killed while it holds a tile."""
 
 import contextlib
 import json
-import math
 import os
 import signal
 import subprocess
@@ -17,22 +16,10 @@ import pytest
 
 import distributed  # noqa: F401 - the test needs it (Debian: python3-distributed)
 import pcl_cocone
+from samples import torus
 from pcl_cocone import tiled
 
 TILE_POINTS = 5000
-
-
-def torus(n, seed=7):
-    """n random points on the torus of radii 1 and 0.4, evenly spread by area."""
-    rng = np.random.default_rng(seed)
-    u, v = np.empty(0), np.empty(0)
-    while len(u) < n:
-        a, b = rng.uniform(0.0, 2.0 * math.pi, (2, n))
-        keep = rng.uniform(0.0, 1.4, n) < 1.0 + 0.4 * np.cos(b)
-        u, v = np.concatenate((u, a[keep])), np.concatenate((v, b[keep]))
-    u, v = u[:n], v[:n]
-    r = 1.0 + 0.4 * np.cos(v)
-    return np.column_stack((r * np.cos(u), r * np.sin(u), 0.4 * np.sin(v)))
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +27,7 @@ def cloud(tmp_path_factory):
     """A torus of 30,000 points in a .npy file and the mesh file the in-process tiled
     run writes for it."""
     directory = tmp_path_factory.mktemp("cloud")
-    points = torus(30000)
+    points = torus(30000, 7)
     path = str(directory / "torus.npy")
     np.save(path, points)
     expected = str(directory / "expected.ply")
@@ -179,7 +166,7 @@ def test_local_cluster_gives_the_in_process_mesh(cloud, tmp_path):
 
 
 def test_a_cloud_of_one_tile_needs_no_cluster(tmp_path):
-    points = torus(3000)
+    points = torus(3000, 7)
     path = tmp_path / "small.xyz"
     np.savetxt(path, points, fmt="%.17g")
     out = tmp_path / "small.ply"
