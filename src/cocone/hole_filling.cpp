@@ -218,12 +218,6 @@ public:
     });
     return found;
   }
-  /** Whether a live triangle has edge ab. */
-  bool
-  hasEdge(int a, int b) const
-  {
-    return traversing(a, b) >= 0 || traversing(b, a) >= 0;
-  }
   void
   kill(int t)
   {
@@ -358,22 +352,32 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
           }
         // The band's borders must be whole loops of the mesh: where the mesh's
         // border goes on outside the band, the triangles along that loop join it.
+        // Walked only from an edge whose next border edge is outside the band: a
+        // loop the band holds whole is not walked at all.
+        const auto next_border = [&](int at, int& triangle) {
+          int next = -1;
+          mesh.forStar(at, [&](int t) {
+            for (int c = 0; c < 3; ++c)
+              if (mesh.triangles()[t][c] == at &&
+                  mesh.traversing(mesh.triangles()[t][(c + 1) % 3], at) < 0) {
+                next = mesh.triangles()[t][(c + 1) % 3];
+                triangle = t;
+              }
+          });
+          return next;
+        };
         for (const auto& e : band_border) {
-          int at = e[1];
+          int triangle = -1;
+          int at = next_border(e[1], triangle);
+          if (at < 0 || in_band[triangle] == band_stamp)
+            continue;
+          blamed.push_back(triangle);
           for (std::size_t steps = 0; at != e[0] && steps < max_edges; ++steps) {
-            int next = -1;
-            mesh.forStar(at, [&](int t) {
-              for (int c = 0; c < 3; ++c)
-                if (mesh.triangles()[t][c] == at &&
-                    mesh.traversing(mesh.triangles()[t][(c + 1) % 3], at) < 0) {
-                  next = mesh.triangles()[t][(c + 1) % 3];
-                  if (in_band[t] != band_stamp)
-                    blamed.push_back(t);
-                }
-            });
-            if (next < 0)
+            at = next_border(at, triangle);
+            if (at < 0)
               break;
-            at = next;
+            if (in_band[triangle] != band_stamp)
+              blamed.push_back(triangle);
           }
         }
         // Each loop taken into the band is a cycle of its border edges.
