@@ -26,6 +26,12 @@ constexpr std::size_t TWO_RING = std::size_t(NEAREST) * (NEAREST + 1);
 constexpr int SPACING_NEIGHBOURS = 6;
 /** Neighbourhood of the smoothing: CGAL's default for jet fitting. */
 constexpr int SMOOTHING_NEIGHBOURS = 24;
+/** Of each neighbour's nearest Delaunay neighbours, the nearest this many count
+ * towards p's two-ring. All 12 give the undersampled labels 0.02 to 0.07 more
+ * precision on the noisy open surfaces of the quality table, but smooth the Stanford
+ * range scans more and close more of their dropouts (mesh-border F1 -0.03 to 0); with
+ * 8 one noisy test surface tears a hole. */
+constexpr int SECOND_RING = 10;
 /** Points a jet is fitted to at least: twice its six coefficients, or the fit
  * follows the noise. */
 constexpr int JET_POINTS = 12;
@@ -262,11 +268,8 @@ private:
 };
 
 /** The K nearest of a vertex's nearest Delaunay neighbours and theirs (its
- * two-ring), the nearest by distance, then id (in no particular order); the
- * vertices excluded are left out. All of each neighbour's neighbours count: with
- * their nearest 10 the whole run takes 0.3 % fewer instructions (50k noisy torus),
- * but the undersampled labels lose 0.03 to 0.07 of their precision on the noisy open
- * surfaces of the quality table; with 8 one of them tears a hole. */
+ * two-ring, SECOND_RING of theirs), the nearest by distance, then id (in no
+ * particular order); the vertices excluded are left out. */
 class TwoRing {
 public:
   TwoRing(const std::vector<Eigen::Vector3d>& points,
@@ -293,7 +296,7 @@ public:
       if (q < 0)
         break;
       offer(q);
-      for (int i = 0; i < NEAREST && nearest_[q][i] >= 0; ++i)
+      for (int i = 0; i < SECOND_RING && nearest_[q][i] >= 0; ++i)
         offer(nearest_[q][i]);
     }
     const int size = std::min(r, k);
