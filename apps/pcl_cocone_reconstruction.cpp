@@ -42,6 +42,7 @@ struct Options {
   bool boundary_detection = true;
   bool noise_handling = true;
   bool fill_holes = true;
+  double hole_width = pcl::cocone::Parameters().hole_width;
   int threads = 1;
   std::size_t tile_points = 0; // one piece
   std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
@@ -77,6 +78,8 @@ printHelp(const char* name)
       "                    used as given even when the cloud is noisy\n"
       "  -no_fill          leave the undersampled holes open (by default a border\n"
       "                    loop that triangles of the local spacing close is closed)\n"
+      "  -hole_width W     an empty hole wider than W of its rim's triangles is a\n"
+      "                    true border, never closed (default 2; 0 = any may close)\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -tile_points N    reconstruct in tiles of at most N points (at least 1000),\n"
       "                    one per thread at a time, stitched into one mesh: memory\n"
@@ -130,6 +133,7 @@ parseOptions(int argc, char** argv)
   // Options that take a value; everything else starting with '-' is a switch.
   const char* with_value[] = {"-rho",
                               "-spacing_factor",
+                              "-hole_width",
                               "-gap_angle",
                               "-theta",
                               "-cocone_angle",
@@ -193,6 +197,9 @@ parseOptions(int argc, char** argv)
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
   o.noise_handling = !find_switch(argc, argv, "-no_denoise");
   o.fill_holes = !find_switch(argc, argv, "-no_fill");
+  o.hole_width = parseNumber(argc, argv, "-hole_width", o.hole_width);
+  if (!(o.hole_width >= 0.0))
+    fail("-hole_width must be >= 0");
   parse_argument(argc, argv, "-boundary", o.boundary_file);
   parse_argument(argc, argv, "-outliers", o.outliers_file);
   parse_argument(argc, argv, "-normals", o.normals_file);
@@ -318,6 +325,7 @@ main(int argc, char** argv)
   cocone.setBoundaryDetection(o.boundary_detection);
   cocone.setNoiseHandling(o.noise_handling);
   cocone.setFillUndersampledHoles(o.fill_holes);
+  cocone.setMaxHoleWidth(o.hole_width);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
   cocone.setTilePoints(o.tile_points);
   pcl::PointCloud<pcl::PointXYZ> unused;
@@ -446,7 +454,8 @@ main(int argc, char** argv)
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
       << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
       << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
-      << ", \"tile_points\": " << o.tile_points << ", \"threads\": " << o.threads
+      << ", \"hole_width\": " << o.hole_width << ", \"tile_points\": " << o.tile_points
+      << ", \"threads\": " << o.threads
       << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
       << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")

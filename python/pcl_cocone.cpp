@@ -42,7 +42,7 @@ struct Result {
 const char* const PARAMETER_NAMES =
     "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
     "noise_handling, noise_threshold, smoothing_iterations, fill_undersampled_holes, "
-    "threads, tile_points and halo_spacings (not for detect_boundary)";
+    "hole_width, threads, tile_points and halo_spacings (not for detect_boundary)";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -168,6 +168,14 @@ parseParameters(const char* function,
       p.noise_handling = toBool(function, name, value);
     else if (name == "fill_undersampled_holes")
       p.fill_undersampled_holes = toBool(function, name, value);
+    else if (name == "hole_width") {
+      p.hole_width = toDouble(function, name, value);
+      requireValue(std::isfinite(p.hole_width) && p.hole_width >= 0.0,
+                   function,
+                   name,
+                   ">= 0",
+                   p.hole_width);
+    }
     else if (name == "noise_threshold") {
       p.noise_threshold = toDouble(function, name, value);
       requireValue(std::isfinite(p.noise_threshold) && p.noise_threshold >= 0.0,
@@ -307,6 +315,7 @@ parametersDict(const cocone::Parameters& p, const cocone::TilingOptions& tiling 
   d["boundary_detection"] = p.boundary_detection;
   d["noise_handling"] = p.noise_handling;
   d["fill_undersampled_holes"] = p.fill_undersampled_holes;
+  d["hole_width"] = p.hole_width;
   d["noise_threshold"] = p.noise_threshold;
   d["smoothing_iterations"] = p.smoothing_iterations;
   d["threads"] = p.threads;
@@ -824,7 +833,9 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
       "noise_handling (outliers set aside, noisy clouds smoothed; default True), "
       "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
-      "that triangles of the local spacing close are closed; default True), threads, "
+      "that triangles of the local spacing close are closed; default True), "
+      "hole_width (an empty hole wider than this many of its rim's triangles is a "
+      "true border, never closed; default 2), threads, "
       "tile_points (in tiles of at most this many points, stitched; default 0: one "
       "piece), halo_spacings (the tiles' halo in spacings, default 8). "
       "Runs without the GIL.");

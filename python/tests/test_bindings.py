@@ -217,8 +217,8 @@ def test_parameters_are_used():
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
                              "cocone_angle", "boundary_detection", "noise_handling",
                              "noise_threshold", "smoothing_iterations",
-                             "fill_undersampled_holes", "threads", "tile_points",
-                             "halo_spacings"}
+                             "fill_undersampled_holes", "hole_width", "threads",
+                             "tile_points", "halo_spacings"}
     assert defaults["noise_handling"] is True
     assert defaults["fill_undersampled_holes"] is True
     assert defaults["smoothing_iterations"] >= 1
@@ -229,6 +229,10 @@ def test_parameters_are_used():
     same = pcl_cocone.reconstruct(points, threads=np.int64(0), ratio=np.float32(0.0),
                                   boundary_detection=np.bool_(True), gap_angle=1)
     assert same.report["parameters"]["gap_angle"] == 1.0
+    assert pcl_cocone.reconstruct(points, hole_width=0).report["parameters"][
+        "hole_width"] == 0.0
+    with pytest.raises(ValueError):
+        pcl_cocone.reconstruct(points, hole_width=-1.0)
 
 
 def test_tiles():

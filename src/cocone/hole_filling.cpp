@@ -64,6 +64,14 @@ withinReach(const std::vector<Eigen::Vector3d>& points,
   return (points[a] - points[b]).squaredNorm() <= longest * longest;
 }
 
+/** Whether a vertex of \a loop is on a true border (classifyBorderLoops()). */
+bool
+onTrueBorder(const std::vector<int>& loop, const std::vector<std::uint8_t>& true_border)
+{
+  return !true_border.empty() &&
+         std::any_of(loop.begin(), loop.end(), [&](int v) { return true_border[v]; });
+}
+
 Kernel::Point_3
 toCgal(const Eigen::Vector3d& p)
 {
@@ -79,7 +87,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       EdgeIncidences& incidences,
                       std::vector<std::vector<int>>& loops,
                       double reach,
-                      std::size_t max_edges)
+                      std::size_t max_edges,
+                      const std::vector<std::uint8_t>& true_border)
 {
   HoleFilling out;
   const std::size_t before = triangles.size();
@@ -88,7 +97,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
   std::vector<LoopTriangle> patch;
   for (auto& loop : loops) {
     const std::size_t k = loop.size();
-    if (k < 3 || k > max_edges) {
+    if (k < 3 || k > max_edges || onTrueBorder(loop, true_border)) {
       open.push_back(std::move(loop));
       continue;
     }
@@ -276,7 +285,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   std::vector<std::vector<int>>& loops,
                   double reach,
                   std::size_t max_edges,
-                  std::size_t band_per_edge)
+                  std::size_t band_per_edge,
+                  const std::vector<std::uint8_t>& true_border)
 {
   HoleFilling out;
   const std::size_t num_vertices = points.size();
@@ -313,7 +323,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   bool changed = false;
   for (const auto& loop : loops) {
     const std::size_t k = loop.size();
-    if (k < 3 || k > max_edges)
+    if (k < 3 || k > max_edges || onTrueBorder(loop, true_border))
       continue;
     // Still a border of the mesh (an earlier patch may have taken it in)?
     if ((mesh.traversing(loop[0], loop[1]) >= 0) ==
@@ -504,12 +514,18 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         }
         return true;
       };
-      // Where the meshes disagree the band widens, and the patch is sought again.
+      // Where the meshes disagree the band widens, and the patch is sought again;
+      // never over a true border.
       const auto widen = [&]() {
         if (band.size() >= max_band)
           return false;
         std::sort(blamed.begin(), blamed.end());
         blamed.erase(std::unique(blamed.begin(), blamed.end()), blamed.end());
+        if (!true_border.empty())
+          for (const int t : blamed)
+            for (const int v : mesh.triangles()[t])
+              if (true_border[v])
+                return false;
         for (const int t : blamed) {
           in_band[t] = band_stamp;
           band.push_back(t);

@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 
+#include <pcl/surface/cocone/border_classification.h>
 #include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/candidates.h>
 #include <pcl/surface/cocone/complex.h>
@@ -158,13 +159,36 @@ reconstruct(Triangulation& dt,
   // each starts at, both set below, matters to them).
   result.border_loops = boundaryLoops(incidences, dt.points.size());
   if (parameters.fill_undersampled_holes && !spacing.empty()) {
+    // Each loop classified once, on the mesh as the walk left it: what the sampling
+    // says there, before any patch changes the triangles round it.
+    const std::vector<std::uint8_t> loop_is_border =
+        classifyBorderLoops(dt.points,
+                            result.triangles,
+                            result.border_loops,
+                            cells.triangles,
+                            parameters.hole_width,
+                            parameters.max_hole_edges);
+    std::vector<std::uint8_t> true_border;
+    if (std::find(loop_is_border.begin(), loop_is_border.end(), 1) !=
+        loop_is_border.end()) {
+      true_border.assign(dt.points.size(), 0);
+      for (std::size_t l = 0; l < loop_is_border.size(); ++l)
+        if (loop_is_border[l])
+          for (const int v : result.border_loops[l])
+            true_border[v] = 1;
+    }
+    const auto fillable = [&](const std::vector<int>& loop) {
+      return loop.size() <= parameters.max_hole_edges &&
+             (true_border.empty() || !true_border[loop[0]]);
+    };
     const HoleFilling filled = fillUndersampledHoles(dt.points,
                                                      spacing,
                                                      result.triangles,
                                                      incidences,
                                                      result.border_loops,
                                                      parameters.hole_reach,
-                                                     parameters.max_hole_edges);
+                                                     parameters.max_hole_edges,
+                                                     true_border);
     counts.holes_filled = filled.holes;
     counts.hole_triangles = filled.triangles;
     result.filled_hole_sizes = filled.sizes;
@@ -179,7 +203,7 @@ reconstruct(Triangulation& dt,
         for (const int v : t)
           region[v] = 0;
       for (const auto& loop : result.border_loops)
-        if (loop.size() <= parameters.max_hole_edges)
+        if (fillable(loop))
           for (const int v : loop)
             region[v] = 1;
       if (std::find(region.begin(), region.end(), 1) == region.end())
@@ -206,7 +230,8 @@ reconstruct(Triangulation& dt,
                                                     result.border_loops,
                                                     parameters.hole_reach,
                                                     parameters.max_hole_edges,
-                                                    band_per_edge);
+                                                    band_per_edge,
+                                                    true_border);
       counts.holes_filled += patched.holes;
       counts.hole_triangles += patched.triangles;
       result.filled_hole_sizes.insert(

@@ -277,8 +277,9 @@ public:
    * disk bounded by the loop or a closed surface, with edges as short (a part
    * sampled too coarsely for the flatness test, such as a thin tube, which it flags
    * all over). No new vertex; the mesh stays an oriented manifold.
-   * getBoundaryPointIndices() is not
-   * changed by it (the paper's output); getBoundaryLoops() lists the loops left.
+   * A loop that is wider than setMaxHoleWidth() of its rim's triangles with no
+   * sample in it is a true border and is left as it is. getBoundaryPointIndices() is
+   * not changed by it (the paper's output); getBoundaryLoops() lists the loops left.
    * \param[in] enabled false: the holes left open, the mesh as without the step
    *            (default true)
    */
@@ -293,6 +294,31 @@ public:
   getFillUndersampledHoles() const
   {
     return parameters_.fill_undersampled_holes;
+  }
+
+  /** \brief The widest empty hole taken for undersampling: a border loop with no
+   * sample in it that is wider than \a width times the triangles at its rim (the
+   * diameter of their median circumcircle) is where the sampling stops, a true
+   * border, and stays open (pcl::cocone::classifyBorderLoops()).
+   *
+   * The default 2 closes a hole where one sample, or a row of them, is missing, and
+   * keeps one of two by two samples or more open: a range scanner's dropout, a
+   * cut-out 4 sample spacings across. Points inside a hole share its width
+   * (m points: width / sqrt(m + 1)). A flat face that the points sample only along
+   * its outline (a CAD mesh's vertices) reads as a true border when wider than this.
+   * \param[in] width in rim triangle diameters; 0: every loop may be closed
+   */
+  void
+  setMaxHoleWidth(double width)
+  {
+    parameters_.hole_width = width;
+  }
+
+  /** \brief The widest empty hole taken for undersampling (setMaxHoleWidth()). */
+  double
+  getMaxHoleWidth() const
+  {
+    return parameters_.hole_width;
   }
 
   /** \brief Whether the noise handling is enabled. */

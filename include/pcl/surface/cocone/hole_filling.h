@@ -55,6 +55,8 @@ struct HoleFilling {
  * \param[in] reach the longest new edge allowed, in local spacings
  * \param[in] max_edges loops longer than this are left open (the search's time
  *                grows with the loop)
+ * \param[in] true_border per vertex: on a true border (classifyBorderLoops()), whose
+ *                loop stays open; empty: none
  */
 HoleFilling
 fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
@@ -63,7 +65,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       EdgeIncidences& incidences,
                       std::vector<std::vector<int>>& loops,
                       double reach,
-                      std::size_t max_edges);
+                      std::size_t max_edges,
+                      const std::vector<std::uint8_t>& true_border = {});
 
 /** \brief Close border loops, and cover points no triangle uses, with the triangles
  * another mesh of the same vertices has there: the original Co-cone's, every vertex
@@ -100,6 +103,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
  * \param[in] max_edges loops longer than this are left open
  * \param[in] band_per_edge the largest band, in triangles per loop edge; 0: only
  *            patches bounded by the loop itself
+ * \param[in] true_border per vertex: on a true border, whose loop stays open and
+ *            which no band reaches; empty: none
  */
 HoleFilling
 fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
@@ -110,7 +115,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   std::vector<std::vector<int>>& loops,
                   double reach,
                   std::size_t max_edges,
-                  std::size_t band_per_edge = 0);
+                  std::size_t band_per_edge = 0,
+                  const std::vector<std::uint8_t>& true_border = {});
 
 /** \brief CGAL's advancing front reconstruction (Cohen-Steiner and Da; CGAL's
  * default plausibility: radius ratio bound 5, beta 0.52) of the points \a region

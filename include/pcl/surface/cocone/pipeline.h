@@ -53,6 +53,11 @@ struct Parameters {
    * 2.3 to 2.6; a patch of a round hole has an edge of 0.87 of its width, so a
    * true hole 3.2 local spacings across or wider stays open. */
   double hole_reach = 2.75;
+  /** The widest undersampled hole with no sample in it, in diameters of the median
+   * circumcircle of the triangles at its rim (classifyBorderLoops()): a wider empty
+   * hole is where the sampling stops, a true border, and stays open. 0: every loop
+   * may be filled. */
+  double hole_width = 2.0;
   /** Border loops longer than this many edges stay open. */
   std::size_t max_hole_edges = 1000;
   /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
