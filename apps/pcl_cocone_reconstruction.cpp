@@ -461,6 +461,7 @@ main(int argc, char** argv)
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
       << "},\n  \"outliers\": " << outliers.indices.size()
       << ",\n  \"outlier_indices\": " << jsonList(outliers.indices)
+      << ",\n  \"true_borders\": " << cocone.getReconstructionCounts().true_borders
       << ",\n  \"holes_filled\": " << cocone.getReconstructionCounts().holes_filled
       << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
       << ",\n  \"triangles\": " << polygons.size()

@@ -433,6 +433,7 @@ toPython(cocone::Result& r,
   counts["walk_conflicts"] = c.walk_conflicts;
   counts["walk_reseeds"] = c.walk_reseeds;
   counts["repair"] = repair;
+  counts["true_borders"] = c.true_borders;
   counts["holes_filled"] = c.holes_filled;
   counts["hole_triangles"] = c.hole_triangles;
 
@@ -523,6 +524,7 @@ eachCount(Counts& c, const F& f)
   f("repair.flipped", c.repair.flipped);
   f("repair.filled", c.repair.filled);
   f("repair.ribbon", c.repair.ribbon);
+  f("true_borders", c.true_borders);
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);
 }

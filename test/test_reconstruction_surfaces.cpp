@@ -866,6 +866,7 @@ TEST(HoleFilling, TrueHolesFourSpacingsAcrossStayOpen)
       const auto m = cocone_test::scoreMesh(s, r);
       EXPECT_TRUE(m.topology.manifold()) << m.str();
       EXPECT_EQ(r.counts.holes_filled, 0u);
+      EXPECT_EQ(r.counts.true_borders, 6u);
       EXPECT_EQ(m.loops, 6u) << m.str();
       EXPECT_EQ(m.topology.euler, 2 - 6);
     }
@@ -915,6 +916,7 @@ TEST(HoleFilling, RangeGridDropoutsStayOpen)
       EXPECT_EQ(topology.components, 1u);
       if (width > 0.0) {
         EXPECT_EQ(r.border_loops.size(), 7u);
+        EXPECT_EQ(r.counts.true_borders, 7u); // the outline too
         EXPECT_EQ(topology.euler, 1 - 6);
       }
       else

@@ -168,6 +168,8 @@ reconstruct(Triangulation& dt,
                             cells.triangles,
                             parameters.hole_width,
                             parameters.max_hole_edges);
+    counts.true_borders = static_cast<std::size_t>(
+        std::count(loop_is_border.begin(), loop_is_border.end(), 1));
     std::vector<std::uint8_t> true_border;
     if (std::find(loop_is_border.begin(), loop_is_border.end(), 1) !=
         loop_is_border.end()) {
