@@ -79,7 +79,7 @@ printHelp(const char* name)
       "  -no_fill          leave the undersampled holes open (by default a border\n"
       "                    loop that triangles of the local spacing close is closed)\n"
       "  -hole_width W     an empty hole wider than W of its rim's triangles is a\n"
-      "                    true border, never closed (default 2; 0 = any may close)\n"
+      "                    true border, never closed (default 2.5; 0 = any may close)\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -tile_points N    reconstruct in tiles of at most N points (at least 1000),\n"
       "                    one per thread at a time, stitched into one mesh: memory\n"

@@ -837,7 +837,7 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
       "that triangles of the local spacing close are closed; default True), "
       "hole_width (an empty hole wider than this many of its rim's triangles is a "
-      "true border, never closed; default 2), threads, "
+      "true border, never closed; default 2.5), threads, "
       "tile_points (in tiles of at most this many points, stitched; default 0: one "
       "piece), halo_spacings (the tiles' halo in spacings, default 8). "
       "Runs without the GIL.");
