@@ -171,14 +171,15 @@ reconstruct(Triangulation& dt,
     counts.true_borders = static_cast<std::size_t>(
         std::count(loop_is_border.begin(), loop_is_border.end(), 1));
     std::vector<std::uint8_t> true_border;
-    if (std::find(loop_is_border.begin(), loop_is_border.end(), 1) !=
-        loop_is_border.end()) {
+    if (counts.true_borders > 0) {
       true_border.assign(dt.points.size(), 0);
       for (std::size_t l = 0; l < loop_is_border.size(); ++l)
         if (loop_is_border[l])
           for (const int v : result.border_loops[l])
             true_border[v] = 1;
     }
+    // A vertex is on one loop at most (one fan each), and a true border's loop is
+    // never changed: its first vertex tells.
     const auto fillable = [&](const std::vector<int>& loop) {
       return loop.size() <= parameters.max_hole_edges &&
              (true_border.empty() || !true_border[loop[0]]);
