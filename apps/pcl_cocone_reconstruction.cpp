@@ -356,8 +356,12 @@ main(int argc, char** argv)
                 outliers.indices.size());
   else
     print_debug("Noise handling off (-no_denoise).\n");
-  std::vector<pcl::Vertices> loops;
+  std::vector<pcl::Vertices> loops, filled;
   cocone.getBoundaryLoops(loops);
+  cocone.getFilledHoles(filled);
+  std::vector<int> filled_sizes;
+  for (const auto& rim : filled)
+    filled_sizes.push_back(static_cast<int>(rim.vertices.size()));
 
   pcl::PolygonMesh mesh;
   mesh.header = blob.header;
@@ -388,11 +392,12 @@ main(int argc, char** argv)
   pcl::cocone::triangleComponents(tris, &components);
   const std::vector<int> border = pcl::cocone::borderVertices(tris);
   print_info("%zu triangles, %zu components, %zu border loops, %zu undersampled "
-             "points.\n",
+             "points, %zu undersampled holes closed.\n",
              polygons.size(),
              components,
              loops.size(),
-             boundary.indices.size());
+             boundary.indices.size(),
+             filled.size());
 
   watch.reset();
   if (!cocone_app::writeMesh(o.output, mesh, error))
@@ -462,7 +467,8 @@ main(int argc, char** argv)
       << "},\n  \"outliers\": " << outliers.indices.size()
       << ",\n  \"outlier_indices\": " << jsonList(outliers.indices)
       << ",\n  \"true_borders\": " << cocone.getReconstructionCounts().true_borders
-      << ",\n  \"holes_filled\": " << cocone.getReconstructionCounts().holes_filled
+      << ",\n  \"holes_filled\": " << filled.size()
+      << ",\n  \"filled_hole_sizes\": " << jsonList(filled_sizes)
       << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
       << ",\n  \"triangles\": " << polygons.size()
       << ",\n  \"components\": " << components

@@ -33,6 +33,7 @@ struct Result {
   py::array triangles;        ///< (M, 3) int32, input indices
   py::array boundary_indices; ///< int32, ascending
   py::list border_loops;      ///< int32 arrays of input indices
+  py::list filled_holes;      ///< int32 arrays: the rims of the holes closed
   py::array normals;          ///< (N, 3) float64, NaN where not in the mesh
   py::array outlier_indices;  ///< int32, ascending
   py::array point_noise;      ///< (N,) float32, NaN where unknown
@@ -395,6 +396,11 @@ toPython(cocone::Result& r,
   out.boundary_indices = indexArray(std::move(r.boundary_indices));
   for (auto& loop : r.border_loops)
     out.border_loops.append(indexArray(std::move(loop)));
+  py::list filled_sizes;
+  for (auto& rim : r.filled_holes) {
+    filled_sizes.append(rim.size());
+    out.filled_holes.append(indexArray(std::move(rim)));
+  }
   out.normals = normals;
   std::vector<int> outliers = takeOutliers(r);
   const std::size_t outlier_count = outliers.size();
@@ -446,6 +452,8 @@ toPython(cocone::Result& r,
   report["triangles"] = triangle_count;
   report["boundary_points"] = boundary_count;
   report["border_loops"] = loop_count;
+  report["holes_filled"] = py::len(filled_sizes);
+  report["filled_hole_sizes"] = filled_sizes;
   report["outliers"] = outlier_count;
   report["noise_level"] = r.noise_level; // about sigma in sample spacings
   report["noise_after_smoothing"] = r.noise_after_smoothing;
@@ -573,6 +581,10 @@ tileToDict(const cocone::TileResult& o)
   d["normal"] = copyArray<double>(o.normal, 3);
   d["kept"] = copyArray<int>(o.kept, 3);
   d["seen"] = copyArray<int>(o.seen, 3);
+  py::list filled;
+  for (const auto& rim : o.filled_holes)
+    filled.append(copyArray<int>(rim, 1));
+  d["filled_holes"] = filled;
   d["ratio"] = o.ratio;
   d["noise_after_smoothing"] = o.noise_after_smoothing;
   d["smoothed"] = o.smoothed;
@@ -623,6 +635,7 @@ tileFromDict(const py::dict& d)
                           "normal",
                           "kept",
                           "seen",
+                          "filled_holes",
                           "ratio",
                           "noise_after_smoothing",
                           "smoothed",
@@ -641,6 +654,13 @@ tileFromDict(const py::dict& d)
   o.normal = arrayField<double, Eigen::Vector3d>(d, "normal", 3);
   o.kept = arrayField<int, cocone::Triangle>(d, "kept", 3);
   o.seen = arrayField<int, cocone::Triangle>(d, "seen", 3);
+  if (!py::isinstance<py::list>(d["filled_holes"]))
+    throw py::value_error("TileResult.from_dict(): 'filled_holes' must be a list");
+  for (const auto& rim : d["filled_holes"].cast<py::list>()) {
+    py::dict one; // each rim checked as the other arrays are
+    one["filled_holes"] = rim;
+    o.filled_holes.push_back(arrayField<int, int>(one, "filled_holes", 1));
+  }
   o.ratio = d["ratio"].cast<double>();
   o.noise_after_smoothing = d["noise_after_smoothing"].cast<double>();
   o.smoothed = d["smoothed"].cast<bool>();
@@ -787,6 +807,11 @@ PYBIND11_MODULE(_pcl_cocone, m)
                     &Result::border_loops,
                     "list of int32 arrays: the mesh's borders as closed loops of "
                     "input indices.")
+      .def_readonly("filled_holes",
+                    &Result::filled_holes,
+                    "list of int32 arrays: the undersampled holes closed, each the "
+                    "border loop it had before, as input indices (its size in "
+                    "edges is its length).")
       .def_readonly("normals",
                     &Result::normals,
                     "(N, 3) float64: oriented unit normal per input point, NaN where "

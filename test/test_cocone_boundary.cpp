@@ -388,6 +388,71 @@ TEST(CoConeBoundary, MeshIndicesReferToTheInputCloud)
   }
 }
 
+TEST(CoConeBoundary, FilledHolesReferToTheInputCloud)
+{
+  // A dropout near the hemisphere's pole, 3 spacings across, the points behind junk
+  // that setIndices leaves out: with a hole width of 4 rim triangles the hole is
+  // closed and its rim reported in the cloud's indices; without the hole filling
+  // the rim is the mesh's second border loop.
+  const auto s = hemisphere();
+  std::size_t pole = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (s.points[i].z() > s.points[pole].z())
+      pole = i;
+  const Eigen::Vector3d centre = s.points[pole];
+  auto cloud = toCloud<pcl::PointXYZ>({});
+  pcl::IndicesPtr indices(new pcl::Indices);
+  for (const auto& p : s.points) {
+    if ((p - centre).norm() < 1.5 * s.spacing)
+      continue;
+    cloud->push_back(pcl::PointXYZ(9.0f, 9.0f, 9.0f)); // junk, not selected
+    indices->push_back(static_cast<int>(cloud->size()));
+    cloud->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  }
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(cloud);
+  cocone.setIndices(indices);
+  cocone.setMaxHoleWidth(4.0);
+  pcl::PolygonMesh mesh;
+  cocone.reconstruct(mesh);
+  std::vector<pcl::Vertices> rims, loops;
+  cocone.getFilledHoles(rims);
+  cocone.getBoundaryLoops(loops);
+  ASSERT_EQ(rims.size(), 1u);
+  EXPECT_EQ(loops.size(), 1u);
+  EXPECT_EQ(cocone.getReconstructionCounts().holes_filled, 1u);
+  std::map<std::pair<int, int>, int> edge_count;
+  for (const auto& p : mesh.polygons)
+    for (int k = 0; k < 3; ++k) {
+      const int a = p.vertices[k], b = p.vertices[(k + 1) % 3];
+      ++edge_count[{std::min(a, b), std::max(a, b)}];
+    }
+  const std::vector<int> rim(rims[0].vertices.begin(), rims[0].vertices.end());
+  ASSERT_GE(rim.size(), 6u);
+  EXPECT_EQ(rim[0], *std::min_element(rim.begin(), rim.end()));
+  for (std::size_t k = 0; k < rim.size(); ++k) {
+    const int a = rim[k], b = rim[(k + 1) % rim.size()];
+    EXPECT_EQ(a % 2, 1) << "not a selected point";
+    EXPECT_LT((cloud->at(a).getVector3fMap().cast<double>() - centre).norm(),
+              3.0 * s.spacing);
+    EXPECT_EQ((edge_count[{std::min(a, b), std::max(a, b)}]), 2) << a << "-" << b;
+  }
+
+  cocone.setFillUndersampledHoles(false);
+  cocone.reconstruct(mesh);
+  cocone.getFilledHoles(rims);
+  cocone.getBoundaryLoops(loops);
+  EXPECT_TRUE(rims.empty());
+  ASSERT_EQ(loops.size(), 2u);
+  const auto& hole = loops[0].vertices.size() < loops[1].vertices.size()
+                         ? loops[0].vertices
+                         : loops[1].vertices;
+  std::vector<int> a(hole.begin(), hole.end()), b = rim;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+}
+
 TEST(CoConeBoundary, NoiseAndOutliers)
 {
   // A noisy hemisphere (sigma half a spacing, random samples) and 5 points 10 radii

@@ -789,8 +789,8 @@ TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
   const auto filled = pcl::cocone::fillHolesFromMesh(
       points, spacing, other, mesh, incidences, loops, 2.75, 1000, 3);
   EXPECT_EQ(filled.holes, 1u);
-  ASSERT_EQ(filled.sizes.size(), 1u);
-  EXPECT_EQ(filled.sizes[0], hole_edges);
+  ASSERT_EQ(filled.rims.size(), 1u);
+  EXPECT_EQ(filled.rims[0].size(), hole_edges);
   const auto topology = pcl::cocone::analyzeMesh(mesh, points.size());
   EXPECT_TRUE(topology.manifold());
   EXPECT_EQ(topology.euler, 1); // a disk
@@ -834,7 +834,13 @@ TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)
                                     pcl::cocone::Stages::RECONSTRUCTION);
     EXPECT_GT(open.border_loops.size(), 0u);
     EXPECT_EQ(r.counts.holes_filled, open.border_loops.size());
-    EXPECT_EQ(r.filled_hole_sizes.size(), r.counts.holes_filled);
+    // The holes reported are the loops the mesh had without the step, in the
+    // caller's ids, each from its lowest id.
+    auto rims = open.border_loops;
+    for (auto& rim : rims)
+      std::rotate(rim.begin(), std::min_element(rim.begin(), rim.end()), rim.end());
+    std::sort(rims.begin(), rims.end());
+    EXPECT_EQ(r.filled_holes, rims);
     const auto m = cocone_test::scoreMesh(c.sample, r);
     EXPECT_TRUE(m.topology.manifold()) << m.str();
     EXPECT_EQ(m.loops, 0u);

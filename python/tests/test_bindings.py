@@ -82,6 +82,30 @@ def test_sphere_with_a_hole():
     assert result.report["border_loops"] == 1
 
 
+def test_filled_holes():
+    """A dropout of nine samples of an even sphere (3 spacings across) is wider than
+    2.5 of its rim's triangles: a true border by default, closed and reported by its
+    rim with a wider hole_width; without the hole filling the mesh's one loop."""
+    points = sphere(3000)
+    points = points[np.linalg.norm(points - points[1500], axis=1) >= 0.1]
+    assert len(points) == 3000 - 9
+    kept = pcl_cocone.reconstruct(points)
+    assert len(kept.border_loops) == 1 and kept.filled_holes == []
+    assert kept.report["counts"]["true_borders"] == 1
+    result = pcl_cocone.reconstruct(points, hole_width=4.0)
+    check_mesh(result, len(points))
+    assert result.border_loops == []
+    assert len(result.filled_holes) == 1
+    rim = result.filled_holes[0]
+    assert rim.dtype == np.int32 and rim[0] == rim.min()
+    assert sorted(rim) == sorted(kept.border_loops[0])
+    assert result.report["holes_filled"] == 1
+    assert result.report["filled_hole_sizes"] == [len(rim)]
+    off = pcl_cocone.reconstruct(points, hole_width=4.0, fill_undersampled_holes=False)
+    assert off.filled_holes == [] and off.report["filled_hole_sizes"] == []
+    assert len(off.border_loops) == 1
+
+
 @pytest.mark.parametrize("tilt, noise", [((0.0, 0.0), 0.0), ((0.1, 0.2), 1e-3)])
 def test_plane_patch(tilt, noise):
     points = plane_patch(tilt=tilt, noise=noise)

@@ -10,12 +10,26 @@
 
 #include <pcl/surface/cocone/pipeline.h>
 
+#include <algorithm>
+#include <vector>
+
 namespace pcl {
 namespace cocone {
 namespace detail {
 
-/** Fill Result::polygons from Result::triangles and turn Result::border_loops into
- * caller ids, each vertex standing as its Result::representative. */
+/** Each loop rotated to start at its lowest id, the loops ordered by it: a listing
+ * that depends neither on the order the loops were found in nor on who found them. */
+inline void
+sortLoops(std::vector<std::vector<int>>& loops)
+{
+  for (auto& loop : loops)
+    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+  std::sort(loops.begin(), loops.end());
+}
+
+/** Fill Result::polygons from Result::triangles and turn Result::border_loops and
+ * Result::filled_holes into caller ids, each vertex standing as its
+ * Result::representative. */
 inline void
 meshToCallerIds(Result& result)
 {
@@ -27,6 +41,10 @@ meshToCallerIds(Result& result)
   for (auto& loop : result.border_loops)
     for (auto& v : loop)
       v = result.representative[v];
+  for (auto& loop : result.filled_holes)
+    for (auto& v : loop)
+      v = result.representative[v];
+  sortLoops(result.filled_holes);
 }
 
 } // namespace detail

@@ -162,7 +162,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     }
     ++out.holes;
     out.triangles += patch.size();
-    out.sizes.push_back(k);
+    out.rims.push_back(loop);
   }
   loops = std::move(open);
   if (triangles.size() > before)
@@ -307,7 +307,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   std::vector<DirectedEdge> rim, band_border;
   std::vector<std::array<int, 2>> rim_keys, patch_edges;
   std::vector<int> rim_vertices, band_uses, taken_vertices;
-  std::vector<std::size_t> absorbed_sizes; // edges of each loop a patch closes
+  std::vector<std::vector<int>> absorbed; // the loops a patch closes
   // Blame: the mesh's triangles outside the band at edge ab, or at vertex v.
   const auto blame_edge = [&](int a, int b) {
     for (const int t : {mesh.traversing(a, b), mesh.traversing(b, a)})
@@ -342,7 +342,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       blamed.clear();
       rim.clear();
       band_border.clear();
-      absorbed_sizes.assign(1, k);
+      absorbed.assign(1, loop);
       if (band.empty()) {
         for (std::size_t i = 0; i < k; ++i) {
           const int a = loop[i], b = loop[(i + 1) % k];
@@ -392,15 +392,15 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         }
         // Each loop taken into the band is a cycle of its border edges.
         std::sort(band_border.begin(), band_border.end());
-        absorbed_sizes.clear();
+        absorbed.clear();
         std::vector<std::uint8_t> seen(band_border.size(), 0);
         for (std::size_t i = 0; i < band_border.size(); ++i) {
           if (seen[i])
             continue;
-          absorbed_sizes.push_back(0);
+          absorbed.emplace_back();
           for (std::size_t j = i; !seen[j];) {
             seen[j] = 1;
-            ++absorbed_sizes.back();
+            absorbed.back().push_back(band_border[j][0]);
             const auto next = std::lower_bound(
                 band_border.begin(),
                 band_border.end(),
@@ -574,7 +574,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       ok = ok && border == rim.size() &&
            eulerCharacteristic(other, patch) ==
                eulerCharacteristic(mesh.triangles(), band) +
-                   static_cast<long>(absorbed_sizes.size());
+                   static_cast<long>(absorbed.size());
       if (!ok)
         break;
       for (const int t : band)
@@ -588,9 +588,9 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         mesh.add(added_triangle);
       }
       in_band.resize(mesh.triangles().size(), -1);
-      out.holes += absorbed_sizes.size();
+      out.holes += absorbed.size();
       out.triangles += patch.size();
-      out.sizes.insert(out.sizes.end(), absorbed_sizes.begin(), absorbed_sizes.end());
+      out.rims.insert(out.rims.end(), absorbed.begin(), absorbed.end());
       changed = true;
       closed = true;
     }

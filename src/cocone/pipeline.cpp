@@ -194,7 +194,7 @@ reconstruct(Triangulation& dt,
                                                      true_border);
     counts.holes_filled = filled.holes;
     counts.hole_triangles = filled.triangles;
-    result.filled_hole_sizes = filled.sizes;
+    result.filled_holes = filled.rims;
     // What the Delaunay patches leave (loops, points in no triangle) the original
     // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
     // coarsely for the flatness test. What those leave, the advancing front's may:
@@ -237,8 +237,8 @@ reconstruct(Triangulation& dt,
                                                     true_border);
       counts.holes_filled += patched.holes;
       counts.hole_triangles += patched.triangles;
-      result.filled_hole_sizes.insert(
-          result.filled_hole_sizes.end(), patched.sizes.begin(), patched.sizes.end());
+      result.filled_holes.insert(
+          result.filled_holes.end(), patched.rims.begin(), patched.rims.end());
     };
     std::vector<std::uint8_t> region = open_region(PLAIN_COCONE_RINGS, true);
     if (!region.empty())

@@ -20,8 +20,10 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <new>
+#include <set>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -421,6 +423,29 @@ forEachTile(std::size_t count, int workers, const Body& body)
     thread.join();
 }
 
+/** One entry per hole among the holes the tiles closed, each given as (whether
+ * another tile owns its rim's lowest id, its rim). A hole near a seam is closed by
+ * each tile that sees it, and tiles may disagree on where a hole is (the triangles
+ * round it differ): the rims are taken owners' first, then in their order, and one
+ * that shares a point with a rim taken is the same hole (a point is on one loop of a
+ * mesh). */
+std::vector<std::vector<int>>
+distinctHoles(std::vector<std::pair<bool, std::vector<int>>> candidates)
+{
+  std::sort(candidates.begin(), candidates.end());
+  std::vector<std::vector<int>> holes;
+  std::set<int> taken;
+  for (auto& candidate : candidates) {
+    std::vector<int>& rim = candidate.second;
+    if (std::any_of(rim.begin(), rim.end(), [&](int id) { return taken.count(id); }))
+      continue;
+    taken.insert(rim.begin(), rim.end());
+    holes.push_back(std::move(rim));
+  }
+  detail::sortLoops(holes);
+  return holes;
+}
+
 /** The stitch of stitchTiles(), on checked input. */
 Result
 stitch(TilePlan& plan,
@@ -456,6 +481,9 @@ stitch(TilePlan& plan,
   if (noise)
     result.point_noise.assign(n, std::numeric_limits<float>::quiet_NaN());
   std::vector<double> ratios, after;
+  // The holes the tiles closed (caller ids), each marked whether another tile owns
+  // its rim's lowest id.
+  std::vector<std::pair<bool, std::vector<int>>> filled;
   for (std::size_t t = 0; t < count; ++t) {
     TileResult& o = outputs[t];
     const std::size_t core_size = plan.coreSize(t);
@@ -480,6 +508,13 @@ stitch(TilePlan& plan,
     if (o.noise_after_smoothing > 0.0)
       after.push_back(o.noise_after_smoothing);
     result.smoothed = result.smoothed || o.smoothed;
+    for (auto& rim : o.filled_holes) {
+      const bool owner =
+          plan.point_tile[static_cast<std::size_t>(ids.position(rim[0]))] ==
+          static_cast<int>(t);
+      filled.push_back({!owner, std::move(rim)});
+    }
+    std::vector<std::vector<int>>().swap(o.filled_holes);
     add(result.counts, o.counts);
     add(result.timings, o.timings);
   }
@@ -698,6 +733,8 @@ stitch(TilePlan& plan,
 
   report.point_tile = std::move(plan.point_tile);
   detail::meshToCallerIds(result);
+  result.filled_holes = distinctHoles(std::move(filled));
+  result.counts.holes_filled = result.filled_holes.size();
   report.stitch_ms = clock.lap();
   result.timings.unique += report.cut_ms;
   result.timings.reconstruction += report.stitch_ms;
@@ -948,6 +985,11 @@ reconstructTile(std::vector<Eigen::Vector3d> points,
         out.seen.push_back(sorted);
       }
     }
+    for (auto& hole : r.filled_holes)
+      if (std::any_of(hole.begin(), hole.end(), [&](int id) {
+            return std::binary_search(core_ids.begin(), core_ids.end(), id);
+          }))
+        out.filled_holes.push_back(std::move(hole));
   }
   catch (const std::bad_alloc&) {
     out = TileResult();

@@ -417,6 +417,15 @@ public:
   void
   getBoundaryLoops(std::vector<pcl::Vertices>& loops) const;
 
+  /** \brief The undersampled holes the last reconstruction closed
+   * (setFillUndersampledHoles()): the border loop each had before, as input indices
+   * with the mesh on its left, each starting at its lowest index, ordered by it. A
+   * rim's size is the hole's size in edges.
+   * \param[out] rims one pcl::Vertices per hole closed
+   */
+  void
+  getFilledHoles(std::vector<pcl::Vertices>& rims) const;
+
   /** \brief Oriented normals from the last reconstruction: the pole direction of
    * every point, turned to the side its mesh faces. A normal estimate with no
    * neighbourhood parameter. At undersampled points, where the pole is unreliable
@@ -489,6 +498,11 @@ private:
   /** Input indices of the last run as PCL indices, with the input's header. */
   void
   toPointIndices(const std::vector<int>& ids, pcl::PointIndices& out) const;
+
+  /** Loops of input indices as pcl::Vertices. */
+  static void
+  toVertices(const std::vector<std::vector<int>>& loops,
+             std::vector<pcl::Vertices>& out);
 
   /** Append the mesh's triangles. */
   void

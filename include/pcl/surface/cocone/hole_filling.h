@@ -24,8 +24,9 @@ struct HoleFilling {
   std::size_t holes = 0;
   /** Triangles added. */
   std::size_t triangles = 0;
-  /** Edges of each hole closed, in the order of the loops. */
-  std::vector<std::size_t> sizes;
+  /** The border loop of each hole closed (vertex ids, the mesh on its left as it
+   * was before), in the order they were closed. */
+  std::vector<std::vector<int>> rims;
 };
 
 /** \brief Close the border loops that are undersampled holes, not true borders

@@ -161,8 +161,10 @@ struct Result {
   std::vector<Triangle> triangles;
   /** The mesh's triangles over caller ids. */
   std::vector<Triangle> polygons;
-  /** Edges of each undersampled hole closed. */
-  std::vector<std::size_t> filled_hole_sizes;
+  /** The border loop each undersampled hole had before it was closed, in caller ids
+   * (the mesh on its left), each starting at its lowest id, ordered by it: where the
+   * holes were and their sizes in edges. */
+  std::vector<std::vector<int>> filled_holes;
   /** Borders of the mesh as closed loops of caller ids. */
   std::vector<std::vector<int>> border_loops;
   /** Per vertex: unit pole direction turned to agree with the mesh (at undersampled

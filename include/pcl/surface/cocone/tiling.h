@@ -161,6 +161,9 @@ struct TileResult {
   /** The tile's other triangles, each with its ids ascending: they may close a seam
    * hole where the tiles that own them disagree. */
   std::vector<Triangle> seen;
+  /** The undersampled holes the tile closed with a rim point in its core, as
+   * Result::filled_holes (the stitch lists each hole once). */
+  std::vector<std::vector<int>> filled_holes;
   /** The ratio the tile used. */
   double ratio = 0.0;
   /** The tile's noise level after smoothing; 0 if it did not try. */

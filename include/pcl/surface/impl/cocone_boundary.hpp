@@ -269,11 +269,27 @@ template <typename PointInT>
 void
 CoConeBoundary<PointInT>::getBoundaryLoops(std::vector<pcl::Vertices>& loops) const
 {
-  loops.clear();
-  for (const auto& loop : result_.border_loops) {
+  toVertices(result_.border_loops, loops);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::getFilledHoles(std::vector<pcl::Vertices>& rims) const
+{
+  toVertices(result_.filled_holes, rims);
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::toVertices(const std::vector<std::vector<int>>& loops,
+                                     std::vector<pcl::Vertices>& out)
+{
+  out.clear();
+  out.reserve(loops.size());
+  for (const auto& loop : loops) {
     pcl::Vertices v;
-    v.vertices = pcl::Indices(loop);
-    loops.push_back(std::move(v));
+    v.vertices.assign(loop.begin(), loop.end());
+    out.push_back(std::move(v));
   }
 }
 
