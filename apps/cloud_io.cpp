@@ -555,6 +555,30 @@ extractXYZ(const pcl::PCLPointCloud2& cloud,
 }
 
 void
+appendPoints(pcl::PCLPointCloud2& cloud, const std::vector<Eigen::Vector3d>& xyz)
+{
+  if (xyz.empty())
+    return;
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  cloud.data.resize((n + xyz.size()) * cloud.point_step, 0);
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    std::uint8_t* p = cloud.data.data() + (n + i) * cloud.point_step;
+    for (int k = 0; k < 3; ++k) {
+      const auto& f = cloud.fields[pcl::getFieldIndex(cloud, std::string(1, "xyz"[k]))];
+      if (f.datatype == pcl::PCLPointField::FLOAT32) {
+        const float v = static_cast<float>(xyz[i][k]);
+        std::memcpy(p + f.offset, &v, 4);
+      }
+      else
+        std::memcpy(p + f.offset, &xyz[i][k], 8);
+    }
+  }
+  cloud.width = static_cast<std::uint32_t>(n + xyz.size());
+  cloud.height = 1;
+  cloud.row_step = cloud.width * cloud.point_step;
+}
+
+void
 appendField(pcl::PCLPointCloud2& cloud,
             const std::string& name,
             std::uint8_t datatype,

@@ -42,6 +42,12 @@ extractXYZ(const pcl::PCLPointCloud2& cloud,
            std::vector<Eigen::Vector3d>& xyz,
            std::string& error);
 
+/** Append points with the given x, y, z (in the fields' own types) and every other
+ * field zero; an organized cloud becomes one row. The cloud has x, y, z (as
+ * extractXYZ() checks). */
+void
+appendPoints(pcl::PCLPointCloud2& cloud, const std::vector<Eigen::Vector3d>& xyz);
+
 /** Set a FLOAT32 field per point: overwrite it if the cloud has it, else append it. */
 void
 setFloatField(pcl::PCLPointCloud2& cloud,

@@ -42,6 +42,7 @@ struct Options {
   bool boundary_detection = true;
   bool noise_handling = true;
   bool fill_holes = true;
+  bool refine_holes = false;
   double hole_width = pcl::cocone::Parameters().hole_width;
   int threads = 1;
   std::size_t tile_points = 0; // one piece
@@ -80,6 +81,9 @@ printHelp(const char* name)
       "                    loop that triangles of the local spacing close is closed)\n"
       "  -hole_width W     an empty hole wider than W of its rim's triangles is a\n"
       "                    true border, never closed (default 2.5; 0 = any may close)\n"
+      "  -refine_holes     refine and fair the patches of the holes closed: new\n"
+      "                    vertices (after the input's points in the mesh), a\n"
+      "                    smooth surface there\n"
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -tile_points N    reconstruct in tiles of at most N points (at least 1000),\n"
       "                    one per thread at a time, stitched into one mesh: memory\n"
@@ -144,8 +148,14 @@ parseOptions(int argc, char** argv)
                               "-normals",
                               "-report",
                               "-screenshot"};
-  const char* switches[] = {
-      "-no_boundary", "-no_denoise", "-no_fill", "-v", "-q", "-h", "--help"};
+  const char* switches[] = {"-no_boundary",
+                            "-no_denoise",
+                            "-no_fill",
+                            "-refine_holes",
+                            "-v",
+                            "-q",
+                            "-h",
+                            "--help"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     bool known = false;
@@ -197,6 +207,7 @@ parseOptions(int argc, char** argv)
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
   o.noise_handling = !find_switch(argc, argv, "-no_denoise");
   o.fill_holes = !find_switch(argc, argv, "-no_fill");
+  o.refine_holes = find_switch(argc, argv, "-refine_holes");
   o.hole_width = parseNumber(argc, argv, "-hole_width", o.hole_width);
   if (!(o.hole_width >= 0.0))
     fail("-hole_width must be >= 0");
@@ -326,11 +337,12 @@ main(int argc, char** argv)
   cocone.setNoiseHandling(o.noise_handling);
   cocone.setFillUndersampledHoles(o.fill_holes);
   cocone.setMaxHoleWidth(o.hole_width);
+  cocone.setRefineFilledHoles(o.refine_holes);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
   cocone.setTilePoints(o.tile_points);
-  pcl::PointCloud<pcl::PointXYZ> unused;
+  pcl::PointCloud<pcl::PointXYZ> points; // the input, then any added vertices
   std::vector<pcl::Vertices> polygons;
-  cocone.reconstruct(unused, polygons);
+  cocone.reconstruct(points, polygons);
   if (cocone.getNumberOfUniquePoints() == 0)
     fail("no reconstruction: the cloud has fewer than 4 distinct finite points or "
          "they are collinear");
@@ -368,14 +380,19 @@ main(int argc, char** argv)
   mesh.cloud = blob;
   mesh.polygons = polygons;
   const std::size_t n = xyz.size();
+  // The vertices -refine_holes added follow the input's points.
+  std::vector<Eigen::Vector3d> added;
+  for (std::size_t i = n; i < points.size(); ++i)
+    added.push_back(points[i].getVector3fMap().cast<double>() + offset);
+  cocone_app::appendPoints(mesh.cloud, added);
   if (!cocone_app::hasColour(blob)) {
     // Undersampled points red, the rest light grey: pcl_viewer shades the triangles
     // around the boundary points.
-    std::vector<std::uint32_t> rgb(n, 0xffc8c8c8u);
+    std::vector<std::uint32_t> rgb(n + added.size(), 0xffc8c8c8u);
     for (const int i : boundary.indices)
       rgb[i] = 0xffc81e1eu;
-    std::vector<std::uint32_t> bits(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::uint32_t> bits(rgb.size());
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
       float f;
       std::memcpy(&f, &rgb[i], 4);
       std::memcpy(&bits[i], &f, 4);
@@ -459,8 +476,9 @@ main(int argc, char** argv)
       << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
       << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
       << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
-      << ", \"hole_width\": " << o.hole_width << ", \"tile_points\": " << o.tile_points
-      << ", \"threads\": " << o.threads
+      << ", \"hole_width\": " << o.hole_width
+      << ", \"refine_filled_holes\": " << (o.refine_holes ? "true" : "false")
+      << ", \"tile_points\": " << o.tile_points << ", \"threads\": " << o.threads
       << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
       << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
@@ -470,6 +488,7 @@ main(int argc, char** argv)
       << ",\n  \"holes_filled\": " << filled.size()
       << ",\n  \"filled_hole_sizes\": " << jsonList(filled_sizes)
       << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
+      << ",\n  \"added_points\": " << added.size()
       << ",\n  \"triangles\": " << polygons.size()
       << ",\n  \"components\": " << components
       << ",\n  \"boundary_loops\": " << loops.size()

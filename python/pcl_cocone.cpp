@@ -34,6 +34,7 @@ struct Result {
   py::array boundary_indices; ///< int32, ascending
   py::list border_loops;      ///< int32 arrays of input indices
   py::list filled_holes;      ///< int32 arrays: the rims of the holes closed
+  py::array added_points;     ///< (K, 3) float64: vertices added inside them
   py::array normals;          ///< (N, 3) float64, NaN where not in the mesh
   py::array outlier_indices;  ///< int32, ascending
   py::array point_noise;      ///< (N,) float32, NaN where unknown
@@ -43,7 +44,8 @@ struct Result {
 const char* const PARAMETER_NAMES =
     "ratio, spacing_factor, gap_angle, normal_angle, cocone_angle, boundary_detection, "
     "noise_handling, noise_threshold, smoothing_iterations, fill_undersampled_holes, "
-    "hole_width, threads, tile_points and halo_spacings (not for detect_boundary)";
+    "hole_width, refine_filled_holes, threads, tile_points and halo_spacings (not for "
+    "detect_boundary)";
 
 /** A float parameter: a real number (not a bool, not a string). */
 double
@@ -169,6 +171,8 @@ parseParameters(const char* function,
       p.noise_handling = toBool(function, name, value);
     else if (name == "fill_undersampled_holes")
       p.fill_undersampled_holes = toBool(function, name, value);
+    else if (name == "refine_filled_holes")
+      p.refine_filled_holes = toBool(function, name, value);
     else if (name == "hole_width") {
       p.hole_width = toDouble(function, name, value);
       requireValue(std::isfinite(p.hole_width) && p.hole_width >= 0.0,
@@ -316,6 +320,7 @@ parametersDict(const cocone::Parameters& p, const cocone::TilingOptions& tiling 
   d["boundary_detection"] = p.boundary_detection;
   d["noise_handling"] = p.noise_handling;
   d["fill_undersampled_holes"] = p.fill_undersampled_holes;
+  d["refine_filled_holes"] = p.refine_filled_holes;
   d["hole_width"] = p.hole_width;
   d["noise_threshold"] = p.noise_threshold;
   d["smoothing_iterations"] = p.smoothing_iterations;
@@ -396,6 +401,14 @@ toPython(cocone::Result& r,
   out.boundary_indices = indexArray(std::move(r.boundary_indices));
   for (auto& loop : r.border_loops)
     out.border_loops.append(indexArray(std::move(loop)));
+  // The vertices refineFilledHoles() added: points n, n + 1, ... of the triangles.
+  std::vector<double> added;
+  for (std::size_t v = r.positions.size() - r.added_vertices; v < r.positions.size();
+       ++v)
+    for (int k = 0; k < 3; ++k)
+      added.push_back(r.positions[v][k] + r.offset[k]);
+  out.added_points = ownedArray(
+      std::move(added), {static_cast<py::ssize_t>(r.added_vertices), py::ssize_t(3)});
   py::list filled_sizes;
   for (auto& rim : r.filled_holes) {
     filled_sizes.append(rim.size());
@@ -454,6 +467,7 @@ toPython(cocone::Result& r,
   report["border_loops"] = loop_count;
   report["holes_filled"] = py::len(filled_sizes);
   report["filled_hole_sizes"] = filled_sizes;
+  report["added_points"] = r.added_vertices;
   report["outliers"] = outlier_count;
   report["noise_level"] = r.noise_level; // about sigma in sample spacings
   report["noise_after_smoothing"] = r.noise_after_smoothing;
@@ -812,6 +826,10 @@ PYBIND11_MODULE(_pcl_cocone, m)
                     "list of int32 arrays: the undersampled holes closed, each the "
                     "border loop it had before, as input indices (its size in "
                     "edges is its length).")
+      .def_readonly("added_points",
+                    &Result::added_points,
+                    "(K, 3) float64: the vertices refine_filled_holes added inside "
+                    "the holes closed; triangles index them as N, N + 1, ...")
       .def_readonly("normals",
                     &Result::normals,
                     "(N, 3) float64: oriented unit normal per input point, NaN where "
@@ -862,7 +880,9 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "noise_threshold, smoothing_iterations, fill_undersampled_holes (border loops "
       "that triangles of the local spacing close are closed; default True), "
       "hole_width (an empty hole wider than this many of its rim's triangles is a "
-      "true border, never closed; default 2.5), threads, "
+      "true border, never closed; default 2.5), refine_filled_holes (the patches "
+      "of the holes closed refined and faired: new vertices, added_points; "
+      "default False), threads, "
       "tile_points (in tiles of at most this many points, stitched; default 0: one "
       "piece), halo_spacings (the tiles' halo in spacings, default 8). "
       "Runs without the GIL.");

@@ -438,6 +438,29 @@ TEST(CoConeBoundary, FilledHolesReferToTheInputCloud)
     EXPECT_EQ((edge_count[{std::min(a, b), std::max(a, b)}]), 2) << a << "-" << b;
   }
 
+  // Refined and faired: the added vertices follow the cloud's points in the mesh.
+  cocone.setRefineFilledHoles(true);
+  pcl::PolygonMesh refined;
+  cocone.reconstruct(refined);
+  const std::size_t added = cocone.getNumberOfAddedPoints();
+  EXPECT_GT(added, 0u);
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  pcl::fromPCLPointCloud2(refined.cloud, vertices);
+  ASSERT_EQ(vertices.size(), cloud->size() + added);
+  EXPECT_EQ(refined.polygons.size(), mesh.polygons.size() + 2 * added);
+  std::size_t uses_added = 0;
+  for (const auto& p : refined.polygons)
+    for (const auto v : p.vertices) {
+      ASSERT_LT(static_cast<std::size_t>(v), vertices.size());
+      EXPECT_TRUE(static_cast<std::size_t>(v) >= cloud->size() || v % 2 == 1);
+      uses_added += static_cast<std::size_t>(v) >= cloud->size();
+    }
+  EXPECT_GE(uses_added, 3 * added);
+  for (std::size_t k = cloud->size(); k < vertices.size(); ++k)
+    EXPECT_LT((vertices[k].getVector3fMap().cast<double>() - centre).norm(),
+              2.0 * s.spacing);
+  cocone.setRefineFilledHoles(false);
+
   cocone.setFillUndersampledHoles(false);
   cocone.reconstruct(mesh);
   cocone.getFilledHoles(rims);

@@ -26,6 +26,7 @@
 #include <numeric>
 #include <ostream>
 #include <random>
+#include <set>
 
 using cocone_test::options;
 using cocone_test::paper;
@@ -849,6 +850,77 @@ TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)
     EXPECT_EQ(m.topology.euler, c.euler);
     EXPECT_GT(m.volume, 0.0); // facing outward
   }
+}
+
+TEST(HoleFilling, RefinedPatchesAreFairAndStayOnTheSurface)
+{
+  // Two dropouts of an even sphere, 3 and 4 spacings across, closed (hole_width 0)
+  // and then refined and faired (refineFilledHoles()): new vertices inside, the
+  // mesh still closed and oriented, the patches as dense as the mesh round them
+  // and on the sphere (the bilaplacian fairing of a cap with its tangent plane held
+  // at the rim; the middle of a flat patch over the wider one would lie 0.13
+  // spacings inside).
+  const auto full = cocone_test::sphere(cocone_test::options(3000));
+  const double h = full.spacing;
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& p : full.points)
+    if ((p - full.points[100]).norm() > 1.5 * h &&
+        (p - full.points[2000]).norm() > 2.0 * h)
+      points.push_back(p);
+  pcl::cocone::Parameters flat;
+  flat.hole_width = 0.0;
+  pcl::cocone::Parameters fair = flat;
+  fair.refine_filled_holes = true;
+  const auto a = pcl::cocone::run(points, flat, pcl::cocone::Stages::RECONSTRUCTION);
+  const auto b = pcl::cocone::run(points, fair, pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_EQ(a.filled_holes.size(), 2u);
+  EXPECT_EQ(b.filled_holes, a.filled_holes);
+  EXPECT_EQ(a.added_vertices, 0u);
+  ASSERT_GT(b.added_vertices, 2u);
+  const std::size_t n = points.size();
+  ASSERT_EQ(b.positions.size(), b.vertices + b.added_vertices);
+  std::vector<Eigen::Vector3d> all = points;
+  for (std::size_t k = 0; k < b.added_vertices; ++k)
+    all.push_back(b.positions[b.vertices + k] + b.offset);
+  const auto topology = pcl::cocone::analyzeMesh(b.polygons, all.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.boundary_edges, 0u);
+  EXPECT_EQ(topology.orientation_conflicts, 0u);
+  EXPECT_EQ(topology.euler, 2);
+  double volume = 0.0;
+  for (const auto& t : b.polygons)
+    volume += all[t[0]].dot(all[t[1]].cross(all[t[2]])) / 6.0;
+  EXPECT_GT(volume, 0.0);
+  // The added vertices: caller ids after the points', on the sphere.
+  double off_surface = 0.0;
+  for (std::size_t k = n; k < all.size(); ++k)
+    off_surface = std::max(off_surface, full.distance(all[k]));
+  std::printf("[ measured ] %zu vertices added, %.4f spacings off the sphere at most\n",
+              b.added_vertices,
+              off_surface / h);
+  EXPECT_LT(off_surface, 0.02 * h);
+  // Outside the patches the mesh is as it was; inside, no edge longer than the
+  // mesh's own round it.
+  std::size_t kept = 0;
+  double longest = 0.0, longest_added = 0.0;
+  std::set<pcl::cocone::Triangle> before;
+  for (auto t : a.polygons) {
+    std::sort(t.begin(), t.end());
+    before.insert(t);
+    for (int c = 0; c < 3; ++c)
+      longest = std::max(longest, (points[t[c]] - points[t[(c + 1) % 3]]).norm());
+  }
+  for (auto t : b.polygons) {
+    std::sort(t.begin(), t.end());
+    if (static_cast<std::size_t>(t[2]) < n) {
+      kept += before.count(t);
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+      longest_added = std::max(longest_added, (all[t[c]] - all[t[(c + 1) % 3]]).norm());
+  }
+  EXPECT_LE(longest_added, longest);
+  EXPECT_GE(kept + 2 * 40, a.polygons.size()); // the two first patches' triangles
 }
 
 TEST(HoleFilling, TrueHolesFourSpacingsAcrossStayOpen)

@@ -730,4 +730,26 @@ TEST(TilingHoles, UndersampledHolesClosedAreListedOnce)
   }
   EXPECT_GT(across, 0u);
   EXPECT_EQ(*std::max_element(on_rim.begin(), on_rim.end()), 1) << "a hole twice";
+
+  // Refined after the stitch: the added vertices are numbered once, after the
+  // points, and the mesh keeps its topology.
+  parameters.refine_filled_holes = true;
+  const Result refined = pcl::cocone::runTiled(kept, parameters, tiling);
+  ASSERT_TRUE(refined.error.empty()) << refined.error;
+  EXPECT_GT(refined.added_vertices, 0u);
+  EXPECT_EQ(refined.filled_holes, tiled.filled_holes);
+  const std::size_t all = kept.size() + refined.added_vertices;
+  const auto before = pcl::cocone::analyzeMesh(tiled.polygons, kept.size());
+  const auto after = pcl::cocone::analyzeMesh(refined.polygons, all);
+  EXPECT_TRUE(after.manifold());
+  EXPECT_EQ(after.orientation_conflicts, 0u);
+  EXPECT_EQ(after.euler, before.euler);
+  EXPECT_EQ(after.boundary_edges, before.boundary_edges);
+  std::vector<int> used(all, 0);
+  for (const Triangle& t : refined.polygons)
+    for (const int v : t)
+      used[v] = 1;
+  EXPECT_EQ(std::count(
+                used.begin() + static_cast<std::ptrdiff_t>(kept.size()), used.end(), 1),
+            static_cast<std::ptrdiff_t>(refined.added_vertices));
 }

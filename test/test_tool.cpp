@@ -219,6 +219,40 @@ TEST_F(Tool, ReportAgreesWithTheLibrary)
   EXPECT_GE(outward, normals.size() * 99 / 100);
 }
 
+TEST_F(Tool, RefinedHolesAddVerticesAfterTheInput)
+{
+  // A dropout in the hemisphere's middle, closed (-hole_width 0) and refined: the
+  // mesh's cloud is the input's points, then the added ones (as the library's).
+  pcl::PointCloud<pcl::PointXYZ> holed;
+  const Eigen::Vector3f top(0.0f, 0.0f, 1.0f);
+  for (const auto& p : *cloud_)
+    if ((p.getVector3fMap() - top).norm() > 2.0f * float(sample_->spacing))
+      holed.push_back(p);
+  const std::string in = dir_ + "/holed.pcd", out = dir_ + "/refined.ply",
+                    report = dir_ + "/refined.json";
+  pcl::io::savePCDFileBinary(in, holed);
+  ASSERT_EQ(run(in + " " + out + " -q -hole_width 0 -refine_holes -report " + report),
+            0);
+  pcl::CoConeBoundary<pcl::PointXYZ> cocone;
+  cocone.setInputCloud(holed.makeShared());
+  cocone.setMaxHoleWidth(0.0);
+  cocone.setRefineFilledHoles(true);
+  pcl::PolygonMesh expected;
+  cocone.reconstruct(expected);
+  const std::size_t added = cocone.getNumberOfAddedPoints();
+  ASSERT_GT(added, 0u);
+  pcl::PolygonMesh mesh;
+  ASSERT_EQ(pcl::io::loadPLYFile(out, mesh), 0);
+  EXPECT_EQ(std::size_t(mesh.cloud.width) * mesh.cloud.height, holed.size() + added);
+  EXPECT_EQ(mesh.polygons.size(), expected.polygons.size());
+  std::ifstream f(report);
+  std::stringstream json;
+  json << f.rdbuf();
+  EXPECT_NE(json.str().find("\"added_points\": " + std::to_string(added) + ","),
+            std::string::npos);
+  EXPECT_NE(json.str().find("\"refine_filled_holes\": true"), std::string::npos);
+}
+
 TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
 {
   const std::string out = dir_ + "/err.vtk";

@@ -101,6 +101,14 @@ def test_filled_holes():
     assert sorted(rim) == sorted(kept.border_loops[0])
     assert result.report["holes_filled"] == 1
     assert result.report["filled_hole_sizes"] == [len(rim)]
+    assert result.added_points.shape == (0, 3)
+    # Refined and faired: new vertices on the sphere, indexed after the points.
+    fair = pcl_cocone.reconstruct(points, hole_width=4.0, refine_filled_holes=True)
+    k = len(fair.added_points)
+    assert k > 0 and fair.report["added_points"] == k
+    assert fair.triangles.max() == len(points) + k - 1
+    assert len(fair.triangles) == len(result.triangles) + 2 * k
+    assert np.all(np.abs(np.linalg.norm(fair.added_points, axis=1) - 1.0) < 0.01)
     off = pcl_cocone.reconstruct(points, hole_width=4.0, fill_undersampled_holes=False)
     assert off.filled_holes == [] and off.report["filled_hole_sizes"] == []
     assert len(off.border_loops) == 1
@@ -241,7 +249,8 @@ def test_parameters_are_used():
     assert set(defaults) == {"ratio", "spacing_factor", "gap_angle", "normal_angle",
                              "cocone_angle", "boundary_detection", "noise_handling",
                              "noise_threshold", "smoothing_iterations",
-                             "fill_undersampled_holes", "hole_width", "threads",
+                             "fill_undersampled_holes", "hole_width",
+                             "refine_filled_holes", "threads",
                              "tile_points", "halo_spacings"}
     assert defaults["noise_handling"] is True
     assert defaults["fill_undersampled_holes"] is True

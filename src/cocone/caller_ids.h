@@ -11,6 +11,8 @@
 #include <pcl/surface/cocone/pipeline.h>
 
 #include <algorithm>
+#include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace pcl {
@@ -25,6 +27,20 @@ sortLoops(std::vector<std::vector<int>>& loops)
   for (auto& loop : loops)
     std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
   std::sort(loops.begin(), loops.end());
+}
+
+/** The caller id of the first vertex refineFilledHoles() adds: one above the
+ * largest of \a ids (of \a count points when \a ids is empty); -1 if there is none
+ * (the largest is the largest int). */
+inline int
+firstAddedId(const std::vector<int>& ids, std::size_t count)
+{
+  if (ids.empty())
+    return count < static_cast<std::size_t>(std::numeric_limits<int>::max())
+               ? static_cast<int>(count)
+               : -1;
+  const int largest = *std::max_element(ids.begin(), ids.end());
+  return largest < std::numeric_limits<int>::max() ? largest + 1 : -1;
 }
 
 /** Fill Result::polygons from Result::triangles and turn Result::border_loops and

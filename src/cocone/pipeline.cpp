@@ -8,6 +8,7 @@
 #include <pcl/surface/cocone/candidates.h>
 #include <pcl/surface/cocone/complex.h>
 #include <pcl/surface/cocone/hole_filling.h>
+#include <pcl/surface/cocone/hole_refinement.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/noise.h>
 #include <pcl/surface/cocone/pipeline.h>
@@ -491,6 +492,11 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   std::sort(result.outlier_indices.begin(), result.outlier_indices.end());
   detail::meshToCallerIds(result);
   result.positions = std::move(dt.points); // the triangulation's last use
+  const int first_added = detail::firstAddedId(ids, result.vertex_of_input.size());
+  if (parameters.refine_filled_holes && first_added >= 0) {
+    refineFilledHoles(result, first_added);
+    result.timings.reconstruction += clock.lap();
+  }
   return result;
 }
 

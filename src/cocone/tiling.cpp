@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 
+#include <pcl/surface/cocone/hole_refinement.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/repair.h>
 #include <pcl/surface/cocone/tiling.h>
@@ -78,6 +79,13 @@ public:
         return false;
       }
     return true;
+  }
+
+  /** The ids it was built with (empty: the positions). */
+  const std::vector<int>&
+  all() const
+  {
+    return *ids_;
   }
 
   int
@@ -735,6 +743,10 @@ stitch(TilePlan& plan,
   detail::meshToCallerIds(result);
   result.filled_holes = distinctHoles(std::move(filled));
   result.counts.holes_filled = result.filled_holes.size();
+  // Refined on the stitched mesh, so that the added vertices are numbered once.
+  const int first_added = detail::firstAddedId(ids.all(), n);
+  if (parameters.refine_filled_holes && first_added >= 0)
+    refineFilledHoles(result, first_added);
   report.stitch_ms = clock.lap();
   result.timings.unique += report.cut_ms;
   result.timings.reconstruction += report.stitch_ms;
@@ -926,6 +938,7 @@ reconstructTile(std::vector<Eigen::Vector3d> points,
 
     Parameters core_statistics = parameters; // the core comes first: it alone counts
     core_statistics.statistics_points = core_points;
+    core_statistics.refine_filled_holes = false; // after the stitch
     Result r = run(std::move(points), core_statistics, Stages::RECONSTRUCTION, ids);
     if (!r.error.empty() && r.vertex_of_input.size() != ids.size()) {
       out.error = r.error; // out of memory, no thread: nothing to go on with

@@ -324,6 +324,35 @@ public:
     return parameters_.hole_width;
   }
 
+  /** \brief Refine and fair the patches that close the undersampled holes, for a
+   * smooth surface there (pcl::cocone::refineFilledHoles(): CGAL's refine() and
+   * fair(), as its triangulate_refine_and_fair_hole()).
+   *
+   * The patches then have new vertices, which follow the input cloud's points in
+   * the output (reconstruct() appends them to the mesh's cloud, their other fields
+   * zero; an organized cloud becomes one row); every other output still indexes
+   * the input cloud alone. \param[in] enabled default false: no new vertex */
+  void
+  setRefineFilledHoles(bool enabled)
+  {
+    parameters_.refine_filled_holes = enabled;
+  }
+
+  /** \brief Whether the patches of the filled holes are refined and faired. */
+  bool
+  getRefineFilledHoles() const
+  {
+    return parameters_.refine_filled_holes;
+  }
+
+  /** \brief Number of vertices the last reconstruction added inside the holes it
+   * closed (setRefineFilledHoles()): the points after the input's in its mesh. */
+  std::size_t
+  getNumberOfAddedPoints() const
+  {
+    return result_.added_vertices;
+  }
+
   /** \brief Whether the noise handling is enabled. */
   bool
   getNoiseHandling() const
@@ -503,6 +532,10 @@ private:
   static void
   toVertices(const std::vector<std::vector<int>>& loops,
              std::vector<pcl::Vertices>& out);
+
+  /** Append the vertices the refinement of the filled holes added. */
+  void
+  appendAddedPoints(pcl::PointCloud<PointInT>& points) const;
 
   /** Append the mesh's triangles. */
   void

@@ -60,6 +60,9 @@ struct Parameters {
    * two 2.1, three by three 2.8; the holes noise tears where registered views
    * overlap up to about 2.4 (at 2.0, 3 of 12 such test clouds kept one). */
   double hole_width = 2.5;
+  /** Refine and fair the patches of the holes closed (refineFilledHoles()): new
+   * vertices inside them, a smooth surface there; false: no new vertex. */
+  bool refine_filled_holes = false;
   /** Border loops longer than this many edges stay open. */
   std::size_t max_hole_edges = 1000;
   /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
@@ -165,6 +168,10 @@ struct Result {
    * (the mesh on its left), each starting at its lowest id, ordered by it: where the
    * holes were and their sizes in edges. */
   std::vector<std::vector<int>> filled_holes;
+  /** Vertices added inside the holes closed (Parameters::refine_filled_holes):
+   * vertex ids from vertices on, caller ids from the largest id given plus one
+   * (refineFilledHoles()). */
+  std::size_t added_vertices = 0;
   /** Borders of the mesh as closed loops of caller ids. */
   std::vector<std::vector<int>> border_loops;
   /** Per vertex: unit pole direction turned to agree with the mesh (at undersampled

@@ -8,7 +8,9 @@
 
 #include <pcl/console/print.h>
 #include <pcl/surface/cocone_boundary.h>
+#include <pcl/conversions.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -323,11 +325,35 @@ template <typename PointInT>
 void
 CoConeBoundary<PointInT>::fillPolygons(std::vector<pcl::Vertices>& polygons) const
 {
+  // The vertices refineFilledHoles() added follow the input cloud's points.
+  const int first_added =
+      ids_.empty() ? 0 : *std::max_element(ids_.begin(), ids_.end()) + 1;
+  const auto index = [&](int id) {
+    return id < first_added ? id : static_cast<int>(cloud_size_) + (id - first_added);
+  };
   polygons.reserve(polygons.size() + result_.polygons.size());
   for (const auto& t : result_.polygons) {
     pcl::Vertices v;
-    v.vertices = {t[0], t[1], t[2]};
+    v.vertices = {index(t[0]), index(t[1]), index(t[2])};
     polygons.push_back(std::move(v));
+  }
+}
+
+template <typename PointInT>
+void
+CoConeBoundary<PointInT>::appendAddedPoints(pcl::PointCloud<PointInT>& points) const
+{
+  const std::size_t added = result_.added_vertices;
+  if (added == 0)
+    return;
+  const std::size_t first = result_.positions.size() - added;
+  for (std::size_t k = 0; k < added; ++k) {
+    const Eigen::Vector3d p = result_.positions[first + k] + result_.offset;
+    PointInT q;
+    q.x = static_cast<float>(p.x());
+    q.y = static_cast<float>(p.y());
+    q.z = static_cast<float>(p.z());
+    points.push_back(q); // an organized cloud becomes one row
   }
 }
 
@@ -372,6 +398,11 @@ CoConeBoundary<PointInT>::performReconstruction(pcl::PolygonMesh& output)
     output.cloud.header = input_->header;
     return;
   }
+  if (result_.added_vertices > 0) {
+    pcl::PointCloud<PointInT> points = *input_;
+    appendAddedPoints(points);
+    pcl::toPCLPointCloud2(points, output.cloud);
+  }
   fillPolygons(output.polygons);
 }
 
@@ -388,6 +419,7 @@ CoConeBoundary<PointInT>::performReconstruction(pcl::PointCloud<PointInT>& point
   }
   // The polygons index the whole input cloud, as in the PolygonMesh overload.
   points = *input_;
+  appendAddedPoints(points);
   fillPolygons(polygons);
 }
 
