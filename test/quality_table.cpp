@@ -99,8 +99,14 @@ ours(const Sample& s)
   if (!r.error.empty())
     return "error: " + r.error;
   const MeshScore m = scoreMesh(s, r);
-  std::string cell =
-      meshCell(m.loops, m.topology, s) + ", " + borderCell(s, r.boundary_indices);
+  // The undersampled points (the paper's output), then the vertices of the mesh's
+  // border loops.
+  std::vector<int> on_border;
+  for (const auto& loop : r.border_loops)
+    on_border.insert(on_border.end(), loop.begin(), loop.end());
+  std::string cell = meshCell(m.loops, m.topology, s) + ", " +
+                     borderCell(s, r.boundary_indices) + "; mesh border " +
+                     borderCell(s, on_border);
   bool outliers = false;
   for (const bool o : s.outlier)
     outliers = outliers || o;

@@ -529,6 +529,28 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
 }
 
 double
+displacementKurtosis(const std::vector<Eigen::Vector3d>& before,
+                     const std::vector<Eigen::Vector3d>& after,
+                     const std::vector<std::uint8_t>& outlier)
+{
+  double m2 = 0.0, m4 = 0.0;
+  std::size_t count = 0;
+  for (std::size_t v = 0; v < before.size(); ++v) {
+    if (!outlier.empty() && outlier[v])
+      continue;
+    const double d2 = (after[v] - before[v]).squaredNorm();
+    m2 += d2;
+    m4 += d2 * d2;
+    ++count;
+  }
+  if (count == 0 || m2 <= 0.0)
+    return 0.0;
+  m2 /= static_cast<double>(count);
+  m4 /= static_cast<double>(count);
+  return m4 / (m2 * m2);
+}
+
+double
 cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
                 const std::vector<std::array<int, NEAREST>>& nearest,
                 const std::vector<std::uint8_t>& outlier,

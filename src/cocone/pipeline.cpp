@@ -294,10 +294,10 @@ countedVertices(const Parameters& parameters, const Result& result)
   return counted;
 }
 
-/** The highest cloud noise level read as noise (about sigma in spacings): noise of
- * one spacing reads 0.87 to 0.90 on the test surfaces, a tube with 7 to 13 samples
- * around its circumference 1.14 to 1.5 (and smoothing would collapse it). */
-constexpr double MAXIMUM_NOISE_LEVEL = 1.05;
+/** Smoothing moved the points as noise would if the kurtosis of their displacements
+ * is at least this (displacementKurtosis(): Gaussian noise 3, points pulled onto a
+ * sheet they do not sample, 1 to 2.5). */
+constexpr double NOISE_KURTOSIS = 2.5;
 /** Smoothing took the noise out if it left at most this share of the noise level. */
 constexpr double SMOOTHED_NOISE_SHARE = 0.5;
 
@@ -323,21 +323,23 @@ handleNoise(Triangulation& dt,
     if (result.vertex_of_input[i] >= 0)
       result.point_noise[i] = noise.level[result.vertex_of_input[i]];
   std::vector<Eigen::Vector3d> kept;
-  // Above about a spacing the neighbourhoods are no surface patches the jets can
-  // follow: a surface too coarse or too creased for them, not noise.
-  if (noise.cloud_level > parameters.noise_threshold &&
-      noise.cloud_level <= MAXIMUM_NOISE_LEVEL) {
+  if (noise.cloud_level > parameters.noise_threshold) {
     kept = smoothPoints(dt.points,
                         cells.nearest,
                         noise.outlier,
                         std::max(parameters.smoothing_iterations, 1),
                         threads);
-    // Smoothing takes noise out; what it leaves is a surface too coarse or creased
-    // for the jets, which smoothing would flatten: then the points stay as they are.
+    // Smoothing takes noise out, moving each point by its own noise; a surface too
+    // coarse or creased for the jets (a tube a few samples round, two sheets closer
+    // than the spacing) it would flatten, moving the points alike or leaving the
+    // level high: then the points stay as they are. The level alone does not tell:
+    // noise of a spacing reads 0.9 on random samples and 1.25 on even ones, tubes
+    // and thin plates 0.9 to 1.5.
     result.noise_after_smoothing =
         cloudNoiseLevel(kept, cells.nearest, noise.outlier, threads, counted);
     result.smoothed =
-        result.noise_after_smoothing < SMOOTHED_NOISE_SHARE * noise.cloud_level;
+        result.noise_after_smoothing < SMOOTHED_NOISE_SHARE * noise.cloud_level &&
+        displacementKurtosis(dt.points, kept, noise.outlier) >= NOISE_KURTOSIS;
   }
   if (!result.smoothed && noise.outliers == 0)
     return false; // a clean cloud: the triangulation stands

@@ -252,10 +252,12 @@ public:
    * Outliers, points off the surface their neighbours sample (flying pixels, points
    * far from everything), are set aside: in no triangle, reported by
    * getOutlierIndices(). When the cloud's noise level (getNoiseLevel()) exceeds 0.1
-   * (and is at most 1.05: above, the neighbourhoods are no surface patches) every
-   * decision is taken on a copy of the points projected twice onto local degree-2
-   * jets, provided this took the noise out (isSmoothed()); the mesh still indexes
-   * the input points. A clean cloud without outliers keeps its result.
+   * every decision is taken on a copy of the points projected twice onto local
+   * degree-2 jets, provided this took the noise out (isSmoothed()): it left at most
+   * half the level, and moved the points as noise would, each by its own amount (a
+   * tube a few samples round, or two sheets closer than the spacing, would be
+   * flattened and keeps its points); the mesh still indexes the input points. A
+   * clean cloud without outliers keeps its result.
    * \param[in] enabled false: the points as given, no outliers (default true)
    */
   void
@@ -371,8 +373,8 @@ public:
 
   /** \brief The noise level of the cloud in the last run read again on the smoothed
    * points (same neighbours): smoothing is kept when it leaves at most half of
-   * getNoiseLevel() (isSmoothed()); 0 if smoothing was not tried (the cloud's level
-   * at most 0.1 or above 1.05, or no noise handling). */
+   * getNoiseLevel() and moved the points as noise would (isSmoothed()); 0 if
+   * smoothing was not tried (the cloud's level at most 0.1, or no noise handling). */
   double
   getNoiseLevelAfterSmoothing() const
   {

@@ -84,6 +84,24 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
                 int threads = 1,
                 const std::vector<std::uint8_t>& counted = {});
 
+/** \brief The kurtosis E|d|^4 / (E|d|^2)^2 of the displacements d of the points
+ * from \a before to \a after (smoothPoints()), outliers left out.
+ *
+ * Smoothing moves a noisy point by its noise, along the normal: Gaussian noise
+ * reads 3 (measured 2.8 to 3.1 on the test surfaces with noise of 0.3 to 1 spacing,
+ * heavier tails more: 8 to 70 on real scans). Where the points are no noisy sample
+ * of one smooth sheet, smoothing moves them all by about as much, the same way, and
+ * the kurtosis is low: two sheets closer than the spacing pulled onto one (a
+ * bimodal spread, about 1), a tube with a few samples round it pulled towards its
+ * axis, a crease rounded (measured 1.05 to 2.46 on thin plates, tubes and cubes).
+ * Assumes the noise is not lighter-tailed than Gaussian: uniform noise reads 1.8.
+ * \return the kurtosis; 0 if no point moved
+ */
+double
+displacementKurtosis(const std::vector<Eigen::Vector3d>& before,
+                     const std::vector<Eigen::Vector3d>& after,
+                     const std::vector<std::uint8_t>& outlier);
+
 /** \brief The points projected onto local fits (scale space): each point moves onto
  * the quadratic height field (a degree-2 jet, as CGAL's jet_smooth_point_set) fitted
  * by least squares to it and its neighbours, \a iterations times, the neighbourhoods

@@ -66,12 +66,13 @@ struct Parameters {
   /** Border loops longer than this many edges stay open. */
   std::size_t max_hole_edges = 1000;
   /** Noise handling (see analyzeNoise()): outliers are set aside, and when the
-   * cloud's noise level exceeds noise_threshold (and is at most 1.05: above, the
-   * neighbourhoods are no surface patches) every decision is taken on a smoothed
-   * copy of the points (smoothPoints()), the mesh still indexing the caller's
-   * points, provided the smoothing took the noise out (left at most half the level:
-   * a surface too coarse or too creased for the jets keeps its level, and is left as
-   * it is). false: the points as given. */
+   * cloud's noise level exceeds noise_threshold every decision is taken on a
+   * smoothed copy of the points (smoothPoints()), the mesh still indexing the
+   * caller's points, provided the smoothing took the noise out: it left at most
+   * half the level and moved the points as noise would (displacementKurtosis() at
+   * least 2.5; a surface too coarse or too creased for the jets, a tube a few
+   * samples round or two sheets closer than the spacing, is left as it is). false:
+   * the points as given. */
   bool noise_handling = true;
   /** The cloud noise level (about sigma in sample spacings) above which the
    * decisions are taken on smoothed points: where the pipeline without smoothing
