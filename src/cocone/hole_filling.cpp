@@ -618,20 +618,28 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       used[v] = 1;
   const std::size_t after_patches = triangles.size();
 
-  // The closed components of the other mesh over free vertices, as they are.
+  // The components of the other mesh over free vertices: a part the flatness test
+  // turned down whole (a tube a few samples round), which the mesh does not reach.
+  // Taken when closed, or when the Delaunay patches close each of its holes and it
+  // is a surface rather than a strip (its border edges at most a quarter of its
+  // triangles): an open patch along a true border keeps a loop no short patch
+  // closes.
   std::vector<int> component(other.size(), -1);
+  std::vector<Triangle> piece;
   for (std::size_t s = 0; s < other.size(); ++s) {
     if (component[s] >= 0 || taken[s])
       continue;
     patch.assign(1, static_cast<int>(s));
     component[s] = static_cast<int>(s);
-    bool closed = true;
+    bool surface = true;
+    std::size_t border = 0;
     for (std::size_t i = 0; i < patch.size(); ++i) {
       const Triangle& t = other[patch[i]];
       for (int c = 0; c < 3; ++c) {
-        closed = closed && !used[t[c]] && short_edge(t[c], t[(c + 1) % 3]);
+        surface = surface && !used[t[c]] && short_edge(t[c], t[(c + 1) % 3]);
         const auto e = theirs.find(t[c], t[(c + 1) % 3]);
-        closed = closed && theirs.count(e) == 2;
+        surface = surface && theirs.count(e) <= 2;
+        border += theirs.count(e) == 1;
         for (std::size_t j = theirs.first[e]; j < theirs.first[e + 1]; ++j) {
           const int next = theirs.triangle[j];
           if (component[next] < 0) {
@@ -641,11 +649,24 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         }
       }
     }
-    if (!closed)
+    if (!surface || 4 * border > patch.size())
       continue;
     std::sort(patch.begin(), patch.end());
+    piece.clear();
     for (const int t : patch)
-      triangles.push_back(other[t]);
+      piece.push_back(other[t]);
+    if (border > 0) {
+      EdgeIncidences piece_incidences(piece);
+      std::vector<std::vector<int>> piece_loops = boundaryLoops(piece, num_vertices);
+      const HoleFilling closed = fillUndersampledHoles(
+          points, spacing, piece, piece_incidences, piece_loops, reach, max_edges, {});
+      if (!piece_loops.empty())
+        continue; // a hole no short patch closes: a border
+      out.holes += closed.holes;
+      out.triangles += closed.triangles;
+      out.rims.insert(out.rims.end(), closed.rims.begin(), closed.rims.end());
+    }
+    triangles.insert(triangles.end(), piece.begin(), piece.end());
     out.triangles += patch.size();
   }
   if (triangles.size() > after_patches)

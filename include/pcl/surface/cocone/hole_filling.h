@@ -91,8 +91,14 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
  * instead: it replaces the band if the band with the holes it holds capped has the
  * patch's Euler characteristic (the genus stays; the mesh's loops the band takes
  * in are closed with it), the rim leaves each of its vertices once, and every new
- * edge is within the reach. A closed component of \a other with such edges, none
- * of whose vertices the mesh uses, is added as it is.
+ * edge is within the reach. A component of \a other with such edges, none of whose
+ * vertices the mesh uses (a part the flatness test turned down whole, such as a
+ * tube a few samples round), is added when it is closed, or when it is a surface
+ * with holes (each edge in at most two of its triangles, its border edges at most
+ * a quarter of its triangles) whose holes fillUndersampledHoles() all closes, with
+ * those patches. Assumes such a part is not a piece of a tube cut off by holes of
+ * its own: one capped at both ends would come out as a closed bead (a tube with
+ * 4 samples round it does).
  * \param[in] points the vertex positions
  * \param[in] spacing per vertex its local spacing (localSpacing())
  * \param[in] other an oriented manifold mesh of the same vertices
