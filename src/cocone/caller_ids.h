@@ -43,17 +43,26 @@ firstAddedId(const std::vector<int>& ids, std::size_t count)
   return largest < std::numeric_limits<int>::max() ? largest + 1 : -1;
 }
 
+/** Result::polygons made anew from Result::triangles, each vertex standing as its
+ * Result::representative. */
+inline void
+polygonsFromTriangles(Result& result)
+{
+  result.polygons.clear();
+  result.polygons.reserve(result.triangles.size());
+  for (const auto& t : result.triangles)
+    result.polygons.push_back({result.representative[t[0]],
+                               result.representative[t[1]],
+                               result.representative[t[2]]});
+}
+
 /** Fill Result::polygons from Result::triangles and turn Result::border_loops and
  * Result::filled_holes into caller ids, each vertex standing as its
  * Result::representative. */
 inline void
 meshToCallerIds(Result& result)
 {
-  result.polygons.reserve(result.triangles.size());
-  for (const auto& t : result.triangles)
-    result.polygons.push_back({result.representative[t[0]],
-                               result.representative[t[1]],
-                               result.representative[t[2]]});
+  polygonsFromTriangles(result);
   for (auto& loop : result.border_loops)
     for (auto& v : loop)
       v = result.representative[v];

@@ -657,7 +657,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       piece.push_back(other[t]);
     if (border > 0) {
       EdgeIncidences piece_incidences(piece);
-      std::vector<std::vector<int>> piece_loops = boundaryLoops(piece, num_vertices);
+      std::vector<std::vector<int>> piece_loops =
+          boundaryLoops(piece_incidences, num_vertices);
       const HoleFilling closed = fillUndersampledHoles(
           points, spacing, piece, piece_incidences, piece_loops, reach, max_edges, {});
       if (!piece_loops.empty())

@@ -10,6 +10,8 @@
 #include <CGAL/Polygon_mesh_processing/refine.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "caller_ids.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -72,12 +74,15 @@ struct Stars {
 
 /** The triangles \a rim bounds on the side away from the mesh it had (the rim has
  * that mesh on its left, so the patch runs along each rim edge backwards); empty
- * if they are no disk within \a limit triangles that the rim closes off. */
+ * if they are no disk within \a limit triangles that the rim closes off. Each
+ * triangle reached is marked \a stamp in \a mark (one entry per triangle). */
 std::vector<int>
 patchOf(const std::vector<int>& rim,
         const std::vector<Triangle>& triangles,
         const std::unordered_map<std::uint64_t, int>& by_edge,
-        std::size_t limit)
+        std::size_t limit,
+        std::vector<int>& mark,
+        int stamp)
 {
   std::vector<std::uint64_t> rim_edges;
   for (std::size_t i = 0; i < rim.size(); ++i) {
@@ -87,7 +92,8 @@ patchOf(const std::vector<int>& rim,
   std::sort(rim_edges.begin(), rim_edges.end());
   std::vector<int> patch, stack;
   const auto visit = [&](int t) {
-    if (std::find(patch.begin(), patch.end(), t) == patch.end()) {
+    if (mark[static_cast<std::size_t>(t)] != stamp) {
+      mark[static_cast<std::size_t>(t)] = stamp;
       patch.push_back(t);
       stack.push_back(t);
     }
@@ -148,7 +154,8 @@ refineFilledHoles(Result& result, int first_id)
   std::vector<std::uint8_t> dead(result.triangles.size(), 0);
   std::vector<Triangle> added_triangles;
   std::vector<Eigen::Vector3d> added_positions;
-  std::vector<int> local_of(vertices, -1), patch_mark(result.triangles.size(), -1);
+  // Per triangle: the hole whose patch or rings it is in (patchOf() marks).
+  std::vector<int> local_of(vertices, -1), in_local(result.triangles.size(), -1);
   for (std::size_t h = 0; h < result.filled_holes.size(); ++h) {
     std::vector<int> rim;
     for (const int id : result.filled_holes[h])
@@ -159,8 +166,9 @@ refineFilledHoles(Result& result, int first_id)
     }
     // A patch has about as many triangles as its rim has edges, more where it
     // replaced a band of the mesh (fillHolesFromMesh()).
+    const int stamp = static_cast<int>(h);
     const std::vector<int> patch =
-        patchOf(rim, result.triangles, by_edge, 8 * rim.size() + 64);
+        patchOf(rim, result.triangles, by_edge, 8 * rim.size() + 64, in_local, stamp);
     bool usable = !patch.empty();
     for (const int t : patch)
       usable = usable && !dead[static_cast<std::size_t>(t)];
@@ -169,13 +177,10 @@ refineFilledHoles(Result& result, int first_id)
       continue;
     }
     // The patch and the rings round it, as a CGAL mesh.
-    for (const int t : patch)
-      patch_mark[static_cast<std::size_t>(t)] = static_cast<int>(h);
     std::vector<int> faces = patch, ring_vertices;
     for (const int t : patch)
       for (const int v : result.triangles[static_cast<std::size_t>(t)])
         ring_vertices.push_back(v);
-    std::size_t ring_begin = 0;
     for (int ring = 0; ring < FIXED_RINGS; ++ring) {
       const std::size_t from = faces.size();
       std::sort(ring_vertices.begin(), ring_vertices.end());
@@ -183,13 +188,11 @@ refineFilledHoles(Result& result, int first_id)
                           ring_vertices.end());
       for (const int v : ring_vertices)
         stars.forStar(v, [&](int t) {
-          if (patch_mark[static_cast<std::size_t>(t)] != static_cast<int>(h) &&
-              std::find(faces.begin() + static_cast<std::ptrdiff_t>(ring_begin),
-                        faces.end(),
-                        t) == faces.end())
+          if (in_local[static_cast<std::size_t>(t)] != stamp) {
+            in_local[static_cast<std::size_t>(t)] = stamp;
             faces.push_back(t);
+          }
         });
-      ring_begin = patch.size();
       ring_vertices.clear();
       for (std::size_t f = from; f < faces.size(); ++f)
         for (const int v : result.triangles[static_cast<std::size_t>(faces[f])])
@@ -219,8 +222,6 @@ refineFilledHoles(Result& result, int first_id)
     }
     for (const int v : global)
       local_of[static_cast<std::size_t>(v)] = -1;
-    for (const int t : patch)
-      patch_mark[static_cast<std::size_t>(t)] = -1;
     std::vector<Mesh::Face_index> new_faces;
     std::vector<Mesh::Vertex_index> new_vertices;
     if (built)
@@ -287,12 +288,7 @@ refineFilledHoles(Result& result, int first_id)
   for (const auto& n : facing)
     result.normals.push_back(n.normalized());
   result.added_vertices += added;
-  result.polygons.clear();
-  result.polygons.reserve(result.triangles.size());
-  for (const auto& t : result.triangles)
-    result.polygons.push_back({result.representative[t[0]],
-                               result.representative[t[1]],
-                               result.representative[t[2]]});
+  detail::polygonsFromTriangles(result);
   return out;
 }
 
