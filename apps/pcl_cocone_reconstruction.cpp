@@ -18,6 +18,7 @@
 #include "screenshot.h"
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +27,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace pcl::console;
@@ -46,6 +48,8 @@ struct Options {
   double hole_width = pcl::cocone::Parameters().hole_width;
   int threads = 1;
   std::size_t tile_points = 0; // one piece
+  bool automatic_tiles = true; // tile_points from the memory
+  double memory_mb = 0.0;      // planned for; 0: what the machine has available
   std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
 };
 
@@ -87,7 +91,10 @@ printHelp(const char* name)
       "  -threads N        number of threads, 0 = all cores (default 1)\n"
       "  -tile_points N    reconstruct in tiles of at most N points (at least 1000),\n"
       "                    one per thread at a time, stitched into one mesh: memory\n"
-      "                    follows N (default 0: one piece)\n"
+      "                    follows N; 0: one piece; auto (default): one piece if it\n"
+      "                    fits the memory, else the largest tiles that do\n"
+      "  -memory MB        the memory -tile_points auto plans for (default: what the\n"
+      "                    machine has available, within the process' cgroup limit)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
       "  -outliers FILE    write the outliers (in no triangle) as a .pcd with their\n"
@@ -143,6 +150,7 @@ parseOptions(int argc, char** argv)
                               "-cocone_angle",
                               "-threads",
                               "-tile_points",
+                              "-memory",
                               "-boundary",
                               "-outliers",
                               "-normals",
@@ -197,13 +205,23 @@ parseOptions(int argc, char** argv)
   if (threads < 0.0 || threads != std::floor(threads) || threads > 4096)
     fail("-threads must be a whole number >= 0");
   o.threads = static_cast<int>(threads);
-  const double tile_points = parseNumber(argc, argv, "-tile_points", 0.0);
-  if (tile_points != std::floor(tile_points) || tile_points > 2e9 ||
-      (tile_points != 0.0 &&
-       tile_points < static_cast<double>(pcl::cocone::MINIMUM_TILE_POINTS)))
-    fail("-tile_points must be 0 (one piece) or a whole number of at least " +
-         std::to_string(pcl::cocone::MINIMUM_TILE_POINTS));
-  o.tile_points = static_cast<std::size_t>(tile_points);
+  std::string tiles;
+  parse_argument(argc, argv, "-tile_points", tiles);
+  o.automatic_tiles = tiles.empty() || tiles == "auto";
+  if (!o.automatic_tiles) {
+    const double tile_points = parseNumber(argc, argv, "-tile_points", 0.0);
+    if (tile_points != std::floor(tile_points) || tile_points > 2e9 ||
+        (tile_points != 0.0 &&
+         tile_points < static_cast<double>(pcl::cocone::MINIMUM_TILE_POINTS)))
+      fail("-tile_points must be auto, 0 (one piece) or a whole number of at least " +
+           std::to_string(pcl::cocone::MINIMUM_TILE_POINTS));
+    o.tile_points = static_cast<std::size_t>(tile_points);
+  }
+  o.memory_mb = parseNumber(argc, argv, "-memory", 0.0);
+  if (!(o.memory_mb >= 0.0) || o.memory_mb > 1e12)
+    fail("-memory must be a number of megabytes >= 0 (0: what is available)");
+  if (o.memory_mb > 0.0 && !o.automatic_tiles)
+    fail("-memory plans the tiles of -tile_points auto; drop it or -tile_points");
   o.boundary_detection = !find_switch(argc, argv, "-no_boundary");
   o.noise_handling = !find_switch(argc, argv, "-no_denoise");
   o.fill_holes = !find_switch(argc, argv, "-no_fill");
@@ -270,6 +288,19 @@ jsonString(const std::string& text)
   return out + "\"";
 }
 
+/** The memory this process holds now, in bytes (0 if unknown): part of the peak
+ * the automatic tile size plans for. */
+std::size_t
+residentMemory()
+{
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0, resident = 0;
+  if (!(statm >> pages >> resident))
+    return 0;
+  const long page = sysconf(_SC_PAGESIZE);
+  return page > 0 ? resident * static_cast<std::size_t>(page) : 0;
+}
+
 } // namespace
 
 int
@@ -326,6 +357,31 @@ main(int argc, char** argv)
   cloud->height = blob.height;
   cloud->is_dense = finite == xyz.size();
 
+  // The tiles: one piece if it fits the memory, else the largest tiles that do.
+  std::size_t tile_points = o.tile_points;
+  if (o.automatic_tiles) {
+    const std::size_t budget = o.memory_mb > 0.0
+                                   ? static_cast<std::size_t>(o.memory_mb * 1048576.0)
+                                   : pcl::cocone::availableMemory() + residentMemory();
+    const unsigned in_flight = o.threads > 0
+                                   ? static_cast<unsigned>(o.threads)
+                                   : std::max(1u, std::thread::hardware_concurrency());
+    bool fits = true;
+    tile_points = pcl::cocone::automaticTilePoints(finite, budget, in_flight, &fits);
+    if (tile_points > 0)
+      print_info("%zu points do not fit %.0f MB in one piece: tiles of at most %zu "
+                 "points.\n",
+                 finite,
+                 budget / 1048576.0,
+                 tile_points);
+    if (!fits)
+      print_warn("Warning: %zu points likely need more than %.0f MB even in tiles of "
+                 "%zu points (the cloud and the stitched mesh are held in memory).\n",
+                 finite,
+                 budget / 1048576.0,
+                 tile_points);
+  }
+
   pcl::CoConeBoundary<pcl::PointXYZ> cocone;
   cocone.setInputCloud(cloud);
   cocone.setRatio(o.ratio);
@@ -339,7 +395,7 @@ main(int argc, char** argv)
   cocone.setMaxHoleWidth(o.hole_width);
   cocone.setRefineFilledHoles(o.refine_holes);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
-  cocone.setTilePoints(o.tile_points);
+  cocone.setTilePoints(tile_points);
   pcl::PointCloud<pcl::PointXYZ> points; // the input, then any added vertices
   std::vector<pcl::Vertices> polygons;
   cocone.reconstruct(points, polygons);
@@ -378,7 +434,6 @@ main(int argc, char** argv)
   pcl::PolygonMesh mesh;
   mesh.header = blob.header;
   mesh.cloud = blob;
-  mesh.polygons = polygons;
   const std::size_t n = xyz.size();
   // The vertices -refine_holes added follow the input's points.
   std::vector<Eigen::Vector3d> added;
@@ -408,9 +463,12 @@ main(int argc, char** argv)
   std::size_t components = 0;
   pcl::cocone::triangleComponents(tris, &components);
   const std::vector<int> border = pcl::cocone::borderVertices(tris);
+  std::vector<pcl::cocone::Triangle>().swap(tris);
+  const std::size_t triangles = polygons.size();
+  mesh.polygons = std::move(polygons); // not copied: a mesh's polygons weigh
   print_info("%zu triangles, %zu components, %zu border loops, %zu undersampled "
              "points, %zu undersampled holes closed.\n",
-             polygons.size(),
+             triangles,
              components,
              loops.size(),
              boundary.indices.size(),
@@ -478,7 +536,9 @@ main(int argc, char** argv)
       << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
       << ", \"hole_width\": " << o.hole_width
       << ", \"refine_filled_holes\": " << (o.refine_holes ? "true" : "false")
-      << ", \"tile_points\": " << o.tile_points << ", \"threads\": " << o.threads
+      << ", \"tile_points\": " << tile_points
+      << ", \"automatic_tiles\": " << (o.automatic_tiles ? "true" : "false")
+      << ", \"threads\": " << o.threads
       << "},\n  \"noise\": {\"level\": " << cocone.getNoiseLevel()
       << ", \"after_smoothing\": " << cocone.getNoiseLevelAfterSmoothing()
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
@@ -489,8 +549,7 @@ main(int argc, char** argv)
       << ",\n  \"filled_hole_sizes\": " << jsonList(filled_sizes)
       << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
       << ",\n  \"added_points\": " << added.size()
-      << ",\n  \"triangles\": " << polygons.size()
-      << ",\n  \"components\": " << components
+      << ",\n  \"triangles\": " << triangles << ",\n  \"components\": " << components
       << ",\n  \"boundary_loops\": " << loops.size()
       << ",\n  \"boundary_indices\": " << jsonList(boundary.indices)
       << ",\n  \"border_indices\": " << jsonList(border) << ",\n  \"timings_ms\": {"

@@ -431,6 +431,41 @@ TEST(TilingOptions, OnePieceWhenTheTileHoldsTheCloud)
   }
 }
 
+TEST(TilingOptions, AutomaticTileSizeFitsTheMemory)
+{
+  using pcl::cocone::automaticTilePoints;
+  const std::size_t mb = 1048576, n = 10000000;
+  bool fits = false;
+  // Unknown memory, or room for one piece: one piece.
+  EXPECT_EQ(automaticTilePoints(n, 0, 2, &fits), 0u);
+  EXPECT_TRUE(fits);
+  EXPECT_EQ(automaticTilePoints(n, n * pcl::cocone::ONE_PIECE_BYTES_PER_POINT, 1), 0u);
+  // Too little for one piece: the largest tiles whose flight fits beside the stitch.
+  for (const unsigned in_flight : {1u, 2u, 8u}) {
+    const std::size_t memory = 8000 * mb;
+    const std::size_t tile = automaticTilePoints(n, memory, in_flight, &fits);
+    SCOPED_TRACE(in_flight);
+    EXPECT_TRUE(fits);
+    ASSERT_GE(tile, pcl::cocone::MINIMUM_TILE_POINTS);
+    ASSERT_LT(tile, n);
+    const auto need = [&](std::size_t t) {
+      return double(n) * pcl::cocone::TILED_BYTES_PER_POINT +
+             1.25 * double(t) * pcl::cocone::ONE_PIECE_BYTES_PER_POINT * in_flight;
+    };
+    EXPECT_LE(need(tile), double(memory));
+    EXPECT_GT(need(tile + 1), double(memory));
+    if (in_flight > 1) {
+      EXPECT_LT(tile, automaticTilePoints(n, memory, 1));
+    }
+  }
+  // Not even the smallest tiles fit: the smallest, and fits says so.
+  EXPECT_EQ(automaticTilePoints(n, 100 * mb, 1, &fits),
+            pcl::cocone::MINIMUM_TILE_POINTS);
+  EXPECT_FALSE(fits);
+  // This machine says what it has.
+  EXPECT_GT(pcl::cocone::availableMemory(), 0u);
+}
+
 TEST(TilingInput, NonFinitePointsDuplicatesAndCallerIds)
 {
   Sample s = cocone_test::sphere(options(6000, 0.0, 1.0, false));

@@ -695,3 +695,62 @@ TEST_F(Tool, TilePointsRunsInTilesAndSaysSo)
   EXPECT_NE(log.find("-tile_points must be"), std::string::npos) << log;
   EXPECT_FALSE(exists(dir_ + "/bad.ply"));
 }
+
+TEST_F(Tool, TileSizeFollowsTheMemory)
+{
+  // By default (-tile_points auto) a cloud that fits the memory is one piece; with
+  // -memory too small for one piece the tool picks tiles that fit, and says so.
+  cocone_test::SampleOptions o;
+  o.n = 20000;
+  const std::vector<Eigen::Vector3d> points = cocone_test::sphere(o).points;
+  savePoints(dir_ + "/auto.pcd", points);
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/auto.pcd " + dir_ + "/auto.ply -report " + dir_ + "/auto.json",
+                &log),
+            0)
+      << log;
+  std::string json = slurpText(dir_ + "/auto.json");
+  EXPECT_NE(json.find("\"tile_points\": 0, \"automatic_tiles\": true"),
+            std::string::npos)
+      << json;
+  pcl::PolygonMesh whole, tiled;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/auto.ply", whole), 0);
+
+  // 20,000 points need about 20 MB in one piece, 11 MB besides the tiles in tiles.
+  const std::size_t expected =
+      pcl::cocone::automaticTilePoints(points.size(), 16 * 1048576, 1);
+  ASSERT_GT(expected, 0u);
+  ASSERT_EQ(run(dir_ + "/auto.pcd " + dir_ + "/auto_tiled.ply -memory 16 -report " +
+                    dir_ + "/auto_tiled.json",
+                &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("tiles of at most " + std::to_string(expected)), std::string::npos)
+      << log;
+  json = slurpText(dir_ + "/auto_tiled.json");
+  EXPECT_NE(json.find("\"tile_points\": " + std::to_string(expected) +
+                      ", \"automatic_tiles\": true"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"boundary_loops\": 0,"), std::string::npos) << json;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/auto_tiled.ply", tiled), 0);
+  EXPECT_EQ(tiled.polygons.size(), whole.polygons.size()); // closed: 2 V - 4
+
+  // Not even tiles fit: a warning, and the smallest tiles.
+  ASSERT_EQ(run(dir_ + "/auto.pcd " + dir_ + "/auto_small.ply -memory 1", &log), 0)
+      << log;
+  EXPECT_NE(
+      log.find("even in tiles of " + std::to_string(pcl::cocone::MINIMUM_TILE_POINTS)),
+      std::string::npos)
+      << log;
+
+  EXPECT_NE(run(dir_ + "/auto.pcd " + dir_ + "/bad.ply -memory -3", &log), 0);
+  EXPECT_NE(log.find("-memory must be"), std::string::npos) << log;
+  EXPECT_NE(
+      run(dir_ + "/auto.pcd " + dir_ + "/bad.ply -memory 10 -tile_points 5000", &log),
+      0);
+  EXPECT_NE(log.find("-memory plans the tiles"), std::string::npos) << log;
+  EXPECT_NE(run(dir_ + "/auto.pcd " + dir_ + "/bad.ply -tile_points many", &log), 0);
+  EXPECT_NE(log.find("is not a number"), std::string::npos) << log;
+  EXPECT_FALSE(exists(dir_ + "/bad.ply"));
+}

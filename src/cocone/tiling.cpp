@@ -15,11 +15,13 @@
 #include "edge_sort.h"
 #include "parallel.h"
 #include "stopwatch.h"
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <functional>
 #include <iterator>
 #include <limits>
@@ -754,6 +756,76 @@ stitch(TilePlan& plan,
 }
 
 } // namespace
+
+std::size_t
+availableMemory()
+{
+  const auto read_number = [](const char* path, std::size_t& value) {
+    std::ifstream in(path);
+    std::string text;
+    if (!(in >> text) || text.empty() ||
+        !std::all_of(
+            text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return false; // absent, or "max": no limit
+    value = static_cast<std::size_t>(std::stoull(text));
+    return true;
+  };
+  std::size_t available = 0;
+  {
+    std::ifstream meminfo("/proc/meminfo");
+    std::string key;
+    std::size_t kb = 0;
+    std::string unit;
+    while (meminfo >> key >> kb >> unit)
+      if (key == "MemAvailable:") {
+        available = kb * 1024;
+        break;
+      }
+  }
+#ifdef _SC_PHYS_PAGES
+  if (available == 0) {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && size > 0)
+      available = static_cast<std::size_t>(pages) * static_cast<std::size_t>(size);
+  }
+#endif
+  // A container's limit: what the group may still take.
+  std::size_t limit = 0, used = 0;
+  if ((read_number("/sys/fs/cgroup/memory.max", limit) &&
+       read_number("/sys/fs/cgroup/memory.current", used)) ||
+      (read_number("/sys/fs/cgroup/memory/memory.limit_in_bytes", limit) &&
+       read_number("/sys/fs/cgroup/memory/memory.usage_in_bytes", used))) {
+    const std::size_t room = limit > used ? limit - used : 0;
+    available = available == 0 ? room : std::min(available, room);
+  }
+  return available;
+}
+
+std::size_t
+automaticTilePoints(std::size_t points,
+                    std::size_t memory,
+                    unsigned int tiles_in_flight,
+                    bool* fits)
+{
+  if (fits)
+    *fits = true;
+  const double budget = static_cast<double>(memory);
+  const double n = static_cast<double>(points);
+  if (memory == 0 || n * ONE_PIECE_BYTES_PER_POINT <= budget)
+    return 0;
+  // A tile of c core points holds about 1.25 c with its halo (8 spacings round a
+  // million points: 1.1 to 1.2 c).
+  const double per_tile_point =
+      1.25 * ONE_PIECE_BYTES_PER_POINT * std::max(1u, tiles_in_flight);
+  const double room = budget - n * TILED_BYTES_PER_POINT;
+  const double core = room / per_tile_point;
+  if (!(core >= static_cast<double>(MINIMUM_TILE_POINTS))) {
+    if (fits)
+      *fits = false;
+    return MINIMUM_TILE_POINTS;
+  }
+  return static_cast<std::size_t>(std::min(core, n));
+}
 
 std::vector<int>
 TilePlan::tilePoints(std::size_t tile) const

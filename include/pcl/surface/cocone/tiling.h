@@ -23,6 +23,45 @@ namespace cocone {
  * spacing are read off too few points. */
 constexpr std::size_t MINIMUM_TILE_POINTS = 1000;
 
+/** \brief Peak memory of a one-piece reconstruction per input point, at most, in
+ * bytes. Measured with the command-line tool, one thread: random samples of 1M to 4M
+ * points need 700 (monkey saddle, torus with noise of 0.5 spacings) to 1,140 bytes
+ * (the clean 1M torus, whose triangulation has 14 cells per point against 6 to 8);
+ * the library alone about 130 bytes less. */
+constexpr std::size_t ONE_PIECE_BYTES_PER_POINT = 1300;
+/** \brief Peak memory of a tiled reconstruction per input point besides its tiles,
+ * at most, in bytes: the cloud, the tiles' results and the stitched mesh (measured as
+ * ONE_PIECE_BYTES_PER_POINT: 410 to 500). A tile in flight needs
+ * ONE_PIECE_BYTES_PER_POINT for each of its points, core and halo. */
+constexpr std::size_t TILED_BYTES_PER_POINT = 550;
+
+/** \brief The memory this process can still use, in bytes: what the system has
+ * available (MemAvailable in /proc/meminfo; otherwise the physical memory), bounded
+ * by the limit of the process' control group (cgroup v2 memory.max or v1
+ * memory.limit_in_bytes, less what the group uses). 0 if none of these can be read. */
+std::size_t
+availableMemory();
+
+/** \brief The tile size for a cloud of \a points to be reconstructed within
+ * \a memory bytes: 0 (one piece) when a one-piece run fits (ONE_PIECE_BYTES_PER_POINT
+ * per point), else the largest core that lets \a tiles_in_flight tiles, each with a
+ * halo of a quarter of its core, run beside the stitch's TILED_BYTES_PER_POINT per
+ * point; at least MINIMUM_TILE_POINTS (when not even that fits, the run will likely
+ * run out of memory: the result is then MINIMUM_TILE_POINTS, and
+ * \a fits is set false).
+ *
+ * \param[in] points the number of points
+ * \param[in] memory the memory to plan for, in bytes (availableMemory()); 0: unknown,
+ *            one piece
+ * \param[in] tiles_in_flight tiles reconstructed at the same time (at least 1)
+ * \param[out] fits if given, whether the plan fits \a memory
+ */
+std::size_t
+automaticTilePoints(std::size_t points,
+                    std::size_t memory,
+                    unsigned int tiles_in_flight,
+                    bool* fits = nullptr);
+
 /** \brief How runTiled() cuts a cloud into tiles (independent of Parameters). */
 struct TilingOptions {
   /** At most this many points in the core of a tile; 0, or at least the number of
