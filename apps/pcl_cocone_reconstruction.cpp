@@ -357,23 +357,29 @@ main(int argc, char** argv)
   cloud->height = blob.height;
   cloud->is_dense = finite == xyz.size();
 
-  // The tiles: one piece if it fits the memory, else the largest tiles that do.
+  // The tiles: one piece if it fits the memory, else the largest tiles that do (as
+  // many at once as fit and there are threads; the mesh does not depend on that).
   std::size_t tile_points = o.tile_points;
+  unsigned tiles_in_flight = 0; // one per thread
   if (o.automatic_tiles) {
     const std::size_t budget = o.memory_mb > 0.0
                                    ? static_cast<std::size_t>(o.memory_mb * 1048576.0)
                                    : pcl::cocone::availableMemory() + residentMemory();
-    const unsigned in_flight = o.threads > 0
-                                   ? static_cast<unsigned>(o.threads)
-                                   : std::max(1u, std::thread::hardware_concurrency());
     bool fits = true;
-    tile_points = pcl::cocone::automaticTilePoints(finite, budget, in_flight, &fits);
-    if (tile_points > 0)
+    tile_points = pcl::cocone::automaticTilePoints(finite, budget, &fits);
+    const unsigned threads = o.threads > 0
+                                 ? static_cast<unsigned>(o.threads)
+                                 : std::max(1u, std::thread::hardware_concurrency());
+    if (tile_points > 0) {
+      tiles_in_flight =
+          pcl::cocone::automaticTilesInFlight(finite, budget, tile_points, threads);
       print_info("%zu points do not fit %.0f MB in one piece: tiles of at most %zu "
-                 "points.\n",
+                 "points, %u at a time.\n",
                  finite,
                  budget / 1048576.0,
-                 tile_points);
+                 tile_points,
+                 tiles_in_flight);
+    }
     if (!fits)
       print_warn("Warning: %zu points likely need more than %.0f MB even in tiles of "
                  "%zu points (the cloud and the stitched mesh are held in memory).\n",
@@ -396,6 +402,7 @@ main(int argc, char** argv)
   cocone.setRefineFilledHoles(o.refine_holes);
   cocone.setNumberOfThreads(static_cast<unsigned>(o.threads));
   cocone.setTilePoints(tile_points);
+  cocone.setTilesInFlight(tiles_in_flight);
   pcl::PointCloud<pcl::PointXYZ> points; // the input, then any added vertices
   std::vector<pcl::Vertices> polygons;
   cocone.reconstruct(points, polygons);

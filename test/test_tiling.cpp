@@ -434,33 +434,40 @@ TEST(TilingOptions, OnePieceWhenTheTileHoldsTheCloud)
 TEST(TilingOptions, AutomaticTileSizeFitsTheMemory)
 {
   using pcl::cocone::automaticTilePoints;
+  using pcl::cocone::automaticTilesInFlight;
   const std::size_t mb = 1048576, n = 10000000;
   bool fits = false;
   // Unknown memory, or room for one piece: one piece.
-  EXPECT_EQ(automaticTilePoints(n, 0, 2, &fits), 0u);
+  EXPECT_EQ(automaticTilePoints(n, 0, &fits), 0u);
   EXPECT_TRUE(fits);
-  EXPECT_EQ(automaticTilePoints(n, n * pcl::cocone::ONE_PIECE_BYTES_PER_POINT, 1), 0u);
-  // Too little for one piece: the largest tiles whose flight fits beside the stitch.
-  for (const unsigned in_flight : {1u, 2u, 8u}) {
-    const std::size_t memory = 8000 * mb;
-    const std::size_t tile = automaticTilePoints(n, memory, in_flight, &fits);
-    SCOPED_TRACE(in_flight);
+  EXPECT_EQ(automaticTilePoints(n, n * pcl::cocone::ONE_PIECE_BYTES_PER_POINT), 0u);
+  const auto need = [&](double tile, unsigned in_flight) {
+    return double(n) * pcl::cocone::TILED_BYTES_PER_POINT +
+           1.25 * tile * pcl::cocone::ONE_PIECE_BYTES_PER_POINT * in_flight;
+  };
+  // Too little for one piece: the largest tile of the series that fits beside the
+  // stitch; a little more or less memory, the same tile.
+  for (const std::size_t memory : {7000 * mb, 8000 * mb, 12000 * mb}) {
+    SCOPED_TRACE(memory / mb);
+    const std::size_t tile = automaticTilePoints(n, memory, &fits);
     EXPECT_TRUE(fits);
     ASSERT_GE(tile, pcl::cocone::MINIMUM_TILE_POINTS);
     ASSERT_LT(tile, n);
-    const auto need = [&](std::size_t t) {
-      return double(n) * pcl::cocone::TILED_BYTES_PER_POINT +
-             1.25 * double(t) * pcl::cocone::ONE_PIECE_BYTES_PER_POINT * in_flight;
-    };
-    EXPECT_LE(need(tile), double(memory));
-    EXPECT_GT(need(tile + 1), double(memory));
-    if (in_flight > 1) {
-      EXPECT_LT(tile, automaticTilePoints(n, memory, 1));
+    EXPECT_LE(need(double(tile), 1), double(memory));
+    EXPECT_GT(need(1.3 * double(tile), 1), double(memory));
+    EXPECT_EQ(automaticTilePoints(n, memory + mb), tile);
+    // As many at once as fit, at most one per thread.
+    for (const unsigned threads : {1u, 2u, 64u}) {
+      const unsigned k = automaticTilesInFlight(n, memory, tile, threads);
+      EXPECT_GE(k, 1u);
+      EXPECT_LE(k, threads);
+      EXPECT_TRUE(k == 1 || need(double(tile), k) <= double(memory));
+      EXPECT_TRUE(k == threads || need(double(tile), k + 1) > double(memory));
     }
   }
+  EXPECT_EQ(automaticTilePoints(n, 8000 * mb), 1600000u); // 2,000,000 would not fit
   // Not even the smallest tiles fit: the smallest, and fits says so.
-  EXPECT_EQ(automaticTilePoints(n, 100 * mb, 1, &fits),
-            pcl::cocone::MINIMUM_TILE_POINTS);
+  EXPECT_EQ(automaticTilePoints(n, 100 * mb, &fits), pcl::cocone::MINIMUM_TILE_POINTS);
   EXPECT_FALSE(fits);
   // This machine says what it has.
   EXPECT_GT(pcl::cocone::availableMemory(), 0u);

@@ -718,7 +718,7 @@ TEST_F(Tool, TileSizeFollowsTheMemory)
 
   // 20,000 points need about 20 MB in one piece, 11 MB besides the tiles in tiles.
   const std::size_t expected =
-      pcl::cocone::automaticTilePoints(points.size(), 16 * 1048576, 1);
+      pcl::cocone::automaticTilePoints(points.size(), 16 * 1048576);
   ASSERT_GT(expected, 0u);
   ASSERT_EQ(run(dir_ + "/auto.pcd " + dir_ + "/auto_tiled.ply -memory 16 -report " +
                     dir_ + "/auto_tiled.json",

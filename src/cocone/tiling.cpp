@@ -801,11 +801,20 @@ availableMemory()
   return available;
 }
 
+namespace {
+
+/** Memory a tile of \a core points takes in flight: its halo adds about a quarter (8
+ * spacings round a million points: 10 to 20 %). */
+double
+tileBytes(double core)
+{
+  return 1.25 * static_cast<double>(ONE_PIECE_BYTES_PER_POINT) * core;
+}
+
+} // namespace
+
 std::size_t
-automaticTilePoints(std::size_t points,
-                    std::size_t memory,
-                    unsigned int tiles_in_flight,
-                    bool* fits)
+automaticTilePoints(std::size_t points, std::size_t memory, bool* fits)
 {
   if (fits)
     *fits = true;
@@ -813,18 +822,39 @@ automaticTilePoints(std::size_t points,
   const double n = static_cast<double>(points);
   if (memory == 0 || n * ONE_PIECE_BYTES_PER_POINT <= budget)
     return 0;
-  // A tile of c core points holds about 1.25 c with its halo (8 spacings round a
-  // million points: 1.1 to 1.2 c).
-  const double per_tile_point =
-      1.25 * ONE_PIECE_BYTES_PER_POINT * std::max(1u, tiles_in_flight);
-  const double room = budget - n * TILED_BYTES_PER_POINT;
-  const double core = room / per_tile_point;
+  const double core = (budget - n * TILED_BYTES_PER_POINT) / tileBytes(1.0);
   if (!(core >= static_cast<double>(MINIMUM_TILE_POINTS))) {
     if (fits)
       *fits = false;
     return MINIMUM_TILE_POINTS;
   }
-  return static_cast<std::size_t>(std::min(core, n));
+  // Down to the series (Renard's R10), in whole points.
+  static const int series[] = {100, 125, 160, 200, 250, 320, 400, 500, 630, 800};
+  double decade = 1.0;
+  while (decade * 10.0 <= core)
+    decade *= 10.0;
+  std::size_t tile = MINIMUM_TILE_POINTS;
+  for (const int step : series) {
+    const double candidate = std::floor(decade * step / 100.0);
+    if (candidate <= core && candidate >= static_cast<double>(MINIMUM_TILE_POINTS))
+      tile = static_cast<std::size_t>(candidate);
+  }
+  return tile;
+}
+
+unsigned int
+automaticTilesInFlight(std::size_t points,
+                       std::size_t memory,
+                       std::size_t tile_points,
+                       unsigned int threads)
+{
+  if (tile_points == 0)
+    return std::max(1u, threads);
+  const double room =
+      static_cast<double>(memory) - static_cast<double>(points) * TILED_BYTES_PER_POINT;
+  const double fit = std::floor(room / tileBytes(static_cast<double>(tile_points)));
+  return static_cast<unsigned>(
+      std::max(1.0, std::min(fit, static_cast<double>(std::max(1u, threads)))));
 }
 
 std::vector<int>

@@ -247,6 +247,22 @@ public:
     return tiling_.tile_points;
   }
 
+  /** \brief Tiles reconstructed at the same time (cocone::TilingOptions::
+   * tiles_in_flight): peak memory grows with it, the output does not depend on it.
+   * \param[in] tiles 0 (the default): one per thread */
+  void
+  setTilesInFlight(unsigned int tiles)
+  {
+    tiling_.tiles_in_flight = tiles;
+  }
+
+  /** \brief Tiles reconstructed at the same time (0: one per thread). */
+  unsigned int
+  getTilesInFlight() const
+  {
+    return tiling_.tiles_in_flight;
+  }
+
   /** \brief Enable or disable the noise handling.
    *
    * Outliers, points off the surface their neighbours sample (flying pixels, points

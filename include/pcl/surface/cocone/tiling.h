@@ -44,23 +44,30 @@ availableMemory();
 
 /** \brief The tile size for a cloud of \a points to be reconstructed within
  * \a memory bytes: 0 (one piece) when a one-piece run fits (ONE_PIECE_BYTES_PER_POINT
- * per point), else the largest core that lets \a tiles_in_flight tiles, each with a
- * halo of a quarter of its core, run beside the stitch's TILED_BYTES_PER_POINT per
- * point; at least MINIMUM_TILE_POINTS (when not even that fits, the run will likely
- * run out of memory: the result is then MINIMUM_TILE_POINTS, and
- * \a fits is set false).
+ * per point), else the largest core that lets one tile, with a halo of a quarter of
+ * its core, run beside the stitch's TILED_BYTES_PER_POINT per point, rounded down to
+ * the series 1, 1.25, 1.6, 2, 2.5, 3.2, 4, 5, 6.3, 8 times a power of ten (a little
+ * more or less memory free gives the same tiles, so the same mesh); at least
+ * MINIMUM_TILE_POINTS (when not even that fits, the run will likely run out of memory:
+ * the result is then MINIMUM_TILE_POINTS, and \a fits is set false). Independent of
+ * the threads, so that the mesh is too; automaticTilesInFlight() says how many such
+ * tiles fit at once.
  *
  * \param[in] points the number of points
  * \param[in] memory the memory to plan for, in bytes (availableMemory()); 0: unknown,
  *            one piece
- * \param[in] tiles_in_flight tiles reconstructed at the same time (at least 1)
  * \param[out] fits if given, whether the plan fits \a memory
  */
 std::size_t
-automaticTilePoints(std::size_t points,
-                    std::size_t memory,
-                    unsigned int tiles_in_flight,
-                    bool* fits = nullptr);
+automaticTilePoints(std::size_t points, std::size_t memory, bool* fits = nullptr);
+
+/** \brief How many tiles of \a tile_points (automaticTilePoints()) fit in \a memory
+ * at once beside the stitch, at most \a threads and at least 1. */
+unsigned int
+automaticTilesInFlight(std::size_t points,
+                       std::size_t memory,
+                       std::size_t tile_points,
+                       unsigned int threads);
 
 /** \brief How runTiled() cuts a cloud into tiles (independent of Parameters). */
 struct TilingOptions {
