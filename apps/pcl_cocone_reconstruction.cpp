@@ -288,19 +288,6 @@ jsonString(const std::string& text)
   return out + "\"";
 }
 
-/** The memory this process holds now, in bytes (0 if unknown): part of the peak
- * the automatic tile size plans for. */
-std::size_t
-residentMemory()
-{
-  std::ifstream statm("/proc/self/statm");
-  std::size_t pages = 0, resident = 0;
-  if (!(statm >> pages >> resident))
-    return 0;
-  const long page = sysconf(_SC_PAGESIZE);
-  return page > 0 ? resident * static_cast<std::size_t>(page) : 0;
-}
-
 } // namespace
 
 int
@@ -364,7 +351,7 @@ main(int argc, char** argv)
   if (o.automatic_tiles) {
     const std::size_t budget = o.memory_mb > 0.0
                                    ? static_cast<std::size_t>(o.memory_mb * 1048576.0)
-                                   : pcl::cocone::availableMemory() + residentMemory();
+                                   : pcl::cocone::availableMemory();
     bool fits = true;
     tile_points = pcl::cocone::automaticTilePoints(finite, budget, &fits);
     const unsigned threads = o.threads > 0

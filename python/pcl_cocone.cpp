@@ -19,6 +19,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -27,6 +28,29 @@ namespace py = pybind11;
 namespace cocone = pcl::cocone;
 
 namespace {
+
+/** tile_points="auto", until the points are known (resolveTiles()). */
+constexpr std::size_t AUTOMATIC_TILES = std::numeric_limits<std::size_t>::max();
+
+/** tile_points="auto" made a size for \a points: as the command-line tool's
+ * -tile_points auto, one piece if it fits the memory available, else the largest
+ * tiles that do, as many at once as fit and there are threads. */
+void
+resolveTiles(cocone::TilingOptions& tiling,
+             std::size_t points,
+             const cocone::Parameters& parameters)
+{
+  if (tiling.tile_points != AUTOMATIC_TILES)
+    return;
+  const std::size_t memory = cocone::availableMemory();
+  tiling.tile_points = cocone::automaticTilePoints(points, memory);
+  tiling.tiles_in_flight = cocone::automaticTilesInFlight(
+      points,
+      memory,
+      tiling.tile_points,
+      parameters.threads > 0 ? parameters.threads
+                             : std::max(1u, std::thread::hardware_concurrency()));
+}
 
 /** What reconstruct() and detect_boundary() return. */
 struct Result {
@@ -194,8 +218,12 @@ parseParameters(const char* function,
     else if (name == "threads")
       p.threads = static_cast<unsigned int>(
           toInt(function, name, value, 0, ">= 0 (0: all processors)"));
+    else if (name == "tile_points" && tiling && py::isinstance<py::str>(value) &&
+             value.cast<std::string>() == "auto")
+      tiling->tile_points = AUTOMATIC_TILES; // resolved once the points are known
     else if (name == "tile_points" && tiling) {
-      const int points = toInt(function, name, value, 0, ">= 0 (0: one piece)");
+      const int points =
+          toInt(function, name, value, 0, ">= 0 (0: one piece) or \"auto\"");
       requireValue(
           points == 0 ||
               static_cast<std::size_t>(points) >= cocone::MINIMUM_TILE_POINTS,
@@ -503,6 +531,7 @@ runPipeline(const char* function,
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     std::vector<Eigen::Vector3d> xyz = readPointArray(array);
+    resolveTiles(tiling, xyz.size(), parameters);
     const auto t1 = Clock::now();
     r = tiling.tile_points > 0
             ? cocone::runTiled(std::move(xyz), parameters, tiling, {}, &tiling_report)
@@ -725,7 +754,9 @@ planTiles(const py::object& points, const py::kwargs& kwargs)
   cocone::TilePlan plan;
   {
     py::gil_scoped_release release;
-    plan = cocone::planTiles(readPointArray(array), parameters, tiling);
+    std::vector<Eigen::Vector3d> xyz = readPointArray(array);
+    resolveTiles(tiling, xyz.size(), parameters);
+    plan = cocone::planTiles(xyz, parameters, tiling);
   }
   if (!plan.error.empty())
     throw std::runtime_error("plan_tiles(): " + plan.error);
@@ -884,7 +915,9 @@ PYBIND11_MODULE(_pcl_cocone, m)
       "of the holes closed refined and faired: new vertices, added_points; "
       "default False), threads, "
       "tile_points (in tiles of at most this many points, stitched; default 0: one "
-      "piece), halo_spacings (the tiles' halo in spacings, default 8). "
+      "piece; \"auto\": one piece if it fits the memory available, else the "
+      "largest tiles that do, as the command-line tool), halo_spacings (the tiles' "
+      "halo in spacings, default 8). "
       "Runs without the GIL.");
   m.def(
       "detect_boundary",

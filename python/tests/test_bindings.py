@@ -282,6 +282,13 @@ def test_tiles():
         pcl_cocone.reconstruct(points, tile_points=5)
     with pytest.raises(TypeError, match="tile_points"):
         pcl_cocone.detect_boundary(points, tile_points=1000)
+    # "auto": a cloud that fits the memory stays in one piece, the same mesh.
+    automatic = pcl_cocone.reconstruct(points, tile_points="auto")
+    assert automatic.report["parameters"]["tile_points"] == 0
+    assert np.array_equal(automatic.triangles, whole.triangles)
+    assert pcl_cocone.plan_tiles(points, tile_points="auto").one_piece
+    with pytest.raises(TypeError, match="tile_points"):
+        pcl_cocone.reconstruct(points, tile_points="many")
 
 
 def same_result(a, b):

@@ -35,10 +35,11 @@ constexpr std::size_t ONE_PIECE_BYTES_PER_POINT = 1300;
  * ONE_PIECE_BYTES_PER_POINT for each of its points, core and halo. */
 constexpr std::size_t TILED_BYTES_PER_POINT = 550;
 
-/** \brief The memory this process can still use, in bytes: what the system has
- * available (MemAvailable in /proc/meminfo; otherwise the physical memory), bounded
- * by the limit of the process' control group (cgroup v2 memory.max or v1
- * memory.limit_in_bytes, less what the group uses). 0 if none of these can be read. */
+/** \brief The memory this process can reach at its peak, in bytes: what it holds
+ * now (its resident set) plus what the system has available (MemAvailable in
+ * /proc/meminfo; otherwise the physical memory), the latter bounded by what the
+ * process' control group may still take (cgroup v2 memory.max or v1
+ * memory.limit_in_bytes, less its use). 0 if none of these can be read. */
 std::size_t
 availableMemory();
 
