@@ -471,6 +471,7 @@ toPython(cocone::Result& r,
   repair["flipped"] = c.repair.flipped;
   repair["filled"] = c.repair.filled;
   repair["ribbon"] = c.repair.ribbon;
+  repair["speck"] = c.repair.speck;
   py::dict counts;
   counts["candidates"] = c.candidates;
   counts["umbrella_failures"] = c.umbrella_failures;
@@ -575,6 +576,7 @@ eachCount(Counts& c, const F& f)
   f("repair.flipped", c.repair.flipped);
   f("repair.filled", c.repair.filled);
   f("repair.ribbon", c.repair.ribbon);
+  f("repair.speck", c.repair.speck);
   f("true_borders", c.true_borders);
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);

@@ -523,5 +523,35 @@ dropRibbons(std::vector<Triangle>& triangles,
   return compact(triangles, drop, incidences);
 }
 
+std::size_t
+dropSpecks(std::vector<Triangle>& triangles,
+           std::size_t num_vertices,
+           std::size_t min_vertices,
+           EdgeIncidences* incidences)
+{
+  std::size_t count = 0;
+  EdgeIncidences grouped;
+  const EdgeIncidences& inc = incidencesOf(triangles, incidences, grouped);
+  const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
+  // Vertices per component: a vertex is in one component (its triangles share it).
+  std::vector<int> component_of(num_vertices, -1);
+  std::vector<std::size_t> vertices(count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int v : triangles[t])
+      if (component_of[v] < 0) {
+        component_of[v] = component[t];
+        ++vertices[component[t]];
+      }
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  bool any = false;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    drop[t] = vertices[component[t]] < min_vertices;
+    any = any || drop[t];
+  }
+  if (incidences && &inc == &grouped)
+    *incidences = std::move(grouped);
+  return any ? compact(triangles, drop, incidences) : 0;
+}
+
 } // namespace cocone
 } // namespace pcl

@@ -31,12 +31,14 @@ struct RepairCounts {
   std::size_t filled = 0;
   /** Dropped with components that have no inner vertex (see dropRibbons()). */
   std::size_t ribbon = 0;
+  /** Dropped with components of too few vertices (see dropSpecks()). */
+  std::size_t speck = 0;
 
   /** Triangles dropped in all. */
   std::size_t
   dropped() const
   {
-    return nonmanifold_edge + nonmanifold_vertex + orientation + ribbon;
+    return nonmanifold_edge + nonmanifold_vertex + orientation + ribbon + speck;
   }
 };
 
@@ -101,6 +103,27 @@ std::size_t
 dropRibbons(std::vector<Triangle>& triangles,
             std::size_t num_vertices,
             EdgeIncidences* incidences = nullptr);
+
+/** \brief Drop every component of the mesh with fewer than \a min_vertices
+ * vertices, closed or not.
+ *
+ * Where two sheets come within a couple of spacings (two spheres nearly touching),
+ * the walk leaves shards of a few triangles across the gap, which the hole filling
+ * would close into beads; an outlier cluster of a few points off a scan gives a
+ * tetrahedron. A closed surface needs more samples than that to be sampled at all
+ * (a sphere covered at epsilon 1 takes about 4 / epsilon^2, at 0.5 sixteen), and a
+ * piece of a few samples says nothing of the surface it came from. Their points
+ * stay vertices, in no triangle.
+ * \param[in,out] incidences if given and not empty, the edge incidences of
+ *                \a triangles (grouped here otherwise); on return those of the
+ *                triangles left
+ * \return the number of triangles dropped
+ */
+std::size_t
+dropSpecks(std::vector<Triangle>& triangles,
+           std::size_t num_vertices,
+           std::size_t min_vertices,
+           EdgeIncidences* incidences = nullptr);
 
 } // namespace cocone
 } // namespace pcl
