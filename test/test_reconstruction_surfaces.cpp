@@ -1008,13 +1008,14 @@ TEST(HoleFilling, RangeGridDropoutsStayOpen)
   }
 }
 
-TEST(HoleFilling, NoSpecksBetweenNearlyTouchingSpheres)
+TEST(HoleFilling, NearlyTouchingSpheres)
 {
-  // Two spheres of 5,000 random samples each, 2 spacings apart: the walk leaves
+  // Two spheres of 5,000 random samples each, 2 spacings apart. The walk leaves
   // shards of 3 to 6 triangles across the gap, which the patches closed into 4
-  // beads (7 components, Euler 12). Pieces of fewer than 8 vertices go: the two
-  // spheres are what is left (each with a hole facing the other, where the sampling
-  // is too coarse for the gap; issue: they should close).
+  // beads (7 components, Euler 12): pieces of fewer than 8 vertices go. Each sphere
+  // then has a hole where it faces the other, round samples no mesh made a surface
+  // of (the Co-cone's and the advancing front's triangles bridge the gap there),
+  // which closes through them (fillHolesWithInnerSamples()): two closed spheres.
   const auto s = cocone_test::twoTouchingSpheres(
       cocone_test::options(10000, 0, 1, false), 1.0, 2.0);
   const auto r = pcl::cocone::run(
@@ -1025,6 +1026,10 @@ TEST(HoleFilling, NoSpecksBetweenNearlyTouchingSpheres)
               r.counts.repair.speck);
   EXPECT_TRUE(m.topology.manifold()) << m.str();
   EXPECT_EQ(m.topology.components, 2u);
+  EXPECT_EQ(m.loops, 0u);
+  EXPECT_EQ(m.topology.euler, 4);
+  EXPECT_GT(m.volume, 0.0);
+  EXPECT_LT(m.max_distance, 0.5); // each patch lies on its sphere
   EXPECT_GT(r.counts.repair.speck, 0u);
   std::size_t pieces = 0;
   const auto component = pcl::cocone::triangleComponents(r.triangles, &pieces);

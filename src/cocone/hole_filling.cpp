@@ -6,8 +6,13 @@
 #include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_face_base_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <Eigen/Dense>
 
 #include <algorithm>
 #include <array>
@@ -672,6 +677,187 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   }
   if (triangles.size() > after_patches)
     incidences.add(triangles, after_patches);
+  return out;
+}
+
+HoleFilling
+fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<double>& spacing,
+                          const std::vector<CoconeTriangle>& cocone_triangles,
+                          std::vector<Triangle>& triangles,
+                          EdgeIncidences& incidences,
+                          std::vector<std::vector<int>>& loops,
+                          double reach,
+                          std::size_t max_edges,
+                          const std::vector<std::uint8_t>& true_border)
+{
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
+  using Fb = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+  using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+  using Cdt = CGAL::
+      Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
+  HoleFilling out;
+  const std::size_t n = points.size();
+  const std::size_t before = triangles.size();
+  std::vector<std::uint8_t> used(n, 0);
+  for (const auto& t : triangles)
+    for (const int v : t)
+      used[v] = 1;
+  // Neighbours through the co-cone triangles, made when a loop needs them.
+  std::vector<std::vector<int>> neighbours;
+  std::vector<std::vector<int>> open;
+  std::vector<Kernel::Point_2> polygon;
+  std::vector<int> inner, stack;
+  std::vector<int> seen(n, -1);
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    std::vector<int>& loop = loops[l];
+    const std::size_t k = loop.size();
+    if (k < 3 || k > max_edges || onTrueBorder(loop, true_border)) {
+      open.push_back(std::move(loop));
+      continue;
+    }
+    // The loop's plane, and a quadratic height over it fitted to the loop.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    double radius = 0.0, rim_spacing = 0.0;
+    for (const int v : loop) {
+      centre += points[v];
+      rim_spacing += spacing[v];
+    }
+    centre /= static_cast<double>(k);
+    rim_spacing /= static_cast<double>(k);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const int v : loop) {
+      const Eigen::Vector3d q = points[v] - centre;
+      scatter += q * q.transpose();
+      radius = std::max(radius, q.norm());
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    const Eigen::Vector3d normal = eigen.eigenvectors().col(0),
+                          u = eigen.eigenvectors().col(2),
+                          w = eigen.eigenvectors().col(1);
+    const auto monomials = [&](const Eigen::Vector3d& q) {
+      const double x = q.dot(u) / radius, y = q.dot(w) / radius;
+      Eigen::Matrix<double, 6, 1> m;
+      m << 1.0, x, y, x * x, x * y, y * y;
+      return m;
+    };
+    Eigen::MatrixXd design(k, 6);
+    Eigen::VectorXd height(k);
+    for (std::size_t i = 0; i < k; ++i) {
+      const Eigen::Vector3d q = points[loop[i]] - centre;
+      design.row(static_cast<Eigen::Index>(i)) = monomials(q).transpose();
+      height(static_cast<Eigen::Index>(i)) = q.dot(normal);
+    }
+    const Eigen::VectorXd fit = design.colPivHouseholderQr().solve(height);
+    const auto flat = [&](int v) {
+      const Eigen::Vector3d q = points[v] - centre;
+      return Kernel::Point_2(q.dot(u), q.dot(w));
+    };
+    // The loop must project to a simple polygon (a hole, not a fold round a tip).
+    polygon.clear();
+    for (const int v : loop)
+      polygon.push_back(flat(v));
+    bool simple = true;
+    for (std::size_t i = 0; i < k && simple; ++i)
+      for (std::size_t j = i + 2; j < k && simple; ++j)
+        if (i != 0 || j != k - 1)
+          simple =
+              !CGAL::do_intersect(Kernel::Segment_2(polygon[i], polygon[(i + 1) % k]),
+                                  Kernel::Segment_2(polygon[j], polygon[(j + 1) % k]));
+    const auto inside = [&](const Kernel::Point_2& p) {
+      return CGAL::bounded_side_2(polygon.begin(), polygon.end(), p, Kernel()) ==
+             CGAL::ON_BOUNDED_SIDE;
+    };
+    // The free samples inside, on the loop's surface (within a spacing of its
+    // height), reached from the loop through the co-cone triangles.
+    inner.clear();
+    if (simple) {
+      if (neighbours.empty()) {
+        neighbours.resize(n);
+        for (const auto& t : cocone_triangles)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              if (i != j)
+                neighbours[t.v[i]].push_back(t.v[j]);
+      }
+      const int stamp = static_cast<int>(l);
+      stack.assign(loop.begin(), loop.end());
+      for (const int v : loop)
+        seen[v] = stamp;
+      while (!stack.empty()) {
+        const int v = stack.back();
+        stack.pop_back();
+        for (const int q : neighbours[v]) {
+          if (used[q] || seen[q] == stamp)
+            continue;
+          seen[q] = stamp;
+          const Eigen::Vector3d d = points[q] - centre;
+          if (d.norm() > radius || !inside(flat(q)) ||
+              std::abs(d.dot(normal) - monomials(d).dot(fit)) > 0.5 * rim_spacing)
+            continue;
+          inner.push_back(q);
+          stack.push_back(q);
+        }
+      }
+    }
+    if (inner.empty()) {
+      open.push_back(std::move(loop));
+      continue;
+    }
+    // The constrained Delaunay triangulation of the loop and the samples inside, in
+    // the plane; its triangles inside the loop make the patch.
+    Cdt cdt;
+    std::vector<Cdt::Vertex_handle> rim;
+    for (std::size_t i = 0; i < k; ++i) {
+      rim.push_back(cdt.insert(polygon[i]));
+      rim.back()->info() = loop[i];
+    }
+    for (std::size_t i = 0; i < k; ++i)
+      cdt.insert_constraint(rim[i], rim[(i + 1) % k]);
+    for (const int q : inner)
+      cdt.insert(flat(q))->info() = q;
+    // Distinct in the plane (no two projected onto one point), every new edge short
+    // and new to the mesh.
+    bool ok = cdt.number_of_vertices() == k + inner.size();
+    std::vector<Triangle> patch;
+    for (auto f = cdt.finite_faces_begin(); ok && f != cdt.finite_faces_end(); ++f) {
+      if (!inside(CGAL::centroid(
+              f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point())))
+        continue;
+      const Triangle t{
+          f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+      for (int e = 0; e < 3 && ok; ++e) {
+        const int a = t[e], b = t[(e + 1) % 3];
+        const bool loop_edge = f->is_constrained((e + 2) % 3); // opposite corner
+        ok = loop_edge ||
+             (withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0);
+      }
+      patch.push_back(t);
+    }
+    if (!ok || patch.empty()) {
+      open.push_back(std::move(loop));
+      continue;
+    }
+    // Counter-clockwise in the plane; the patch runs against the loop, which has the
+    // mesh on its left: turned over if it runs along it.
+    bool along = false;
+    for (const auto& t : patch)
+      for (int e = 0; e < 3; ++e)
+        along = along || (t[e] == loop[0] && t[(e + 1) % 3] == loop[1]);
+    for (Triangle t : patch) {
+      if (along)
+        std::swap(t[1], t[2]);
+      triangles.push_back(t);
+    }
+    for (const int q : inner)
+      used[q] = 1;
+    ++out.holes;
+    out.triangles += patch.size();
+    out.rims.push_back(std::move(loop));
+  }
+  loops = std::move(open);
+  if (triangles.size() > before)
+    incidences.add(triangles, before);
   return out;
 }
 

@@ -34,7 +34,6 @@
 
 namespace pcl {
 namespace cocone {
-
 namespace {
 
 /** Stages 5-7 and the repair over stage 4's candidates: the oriented manifold
@@ -270,6 +269,20 @@ reconstruct(Triangulation& dt,
       counts.holes_filled -= static_cast<std::size_t>(result.filled_holes.end() - gone);
       result.filled_holes.erase(gone, result.filled_holes.end());
     }
+    // Holes round samples no mesh made a surface of, closed through them.
+    const HoleFilling through = fillHolesWithInnerSamples(dt.points,
+                                                          spacing,
+                                                          cells.triangles,
+                                                          result.triangles,
+                                                          incidences,
+                                                          result.border_loops,
+                                                          parameters.hole_reach,
+                                                          parameters.max_hole_edges,
+                                                          true_border);
+    counts.holes_filled += through.holes;
+    counts.hole_triangles += through.triangles;
+    result.filled_holes.insert(
+        result.filled_holes.end(), through.rims.begin(), through.rims.end());
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

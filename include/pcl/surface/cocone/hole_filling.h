@@ -6,6 +6,7 @@
 #pragma once
 
 #include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/voronoi_cell.h>
 
 #include <Eigen/Core>
 
@@ -124,6 +125,44 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   std::size_t max_edges,
                   std::size_t band_per_edge = 0,
                   const std::vector<std::uint8_t>& true_border = {});
+
+/** \brief Close border loops round samples no triangle uses, through them: the
+ * sampling goes on inside the hole, but neither the walk nor the other meshes
+ * (fillHolesFromMesh()) made a surface of it (where two sheets come within a couple
+ * of spacings, as two spheres nearly touching, both meshes bridge the gap; on a
+ * flat face of a mesh's vertices sampled more sparsely than its surroundings).
+ *
+ * The loop is projected onto its best-fit plane, where it must be a simple polygon;
+ * the free samples inside it (reached from the loop through the co-cone triangles)
+ * within half its local spacing of the quadratic height the loop's vertices fit over
+ * that plane are the hole's (at a whole spacing, spheres 2 spacings apart lent one
+ * hole a sample of the other); CGAL's constrained Delaunay triangulation of the polygon
+ * and them, in the plane, gives the patch: its triangles inside the polygon, every new
+ * edge at most \a reach local spacings long and new to the mesh, facing as the
+ * mesh. Assumes the hole is a height field over the loop's plane (small against
+ * the surface's curvature) and the other sheet, if any, more than half a spacing
+ * from the loop's surface; a hole without free samples inside is left to the others.
+ * \param[in] points the vertex positions
+ * \param[in] spacing per vertex its local spacing (localSpacing())
+ * \param[in] cocone_triangles the co-cone triangles (VoronoiCells::triangles)
+ * \param[in,out] triangles the oriented manifold mesh; the patches are appended
+ * \param[in,out] incidences the mesh's edge incidences, kept up to date
+ * \param[in,out] loops the mesh's border loops; the closed ones are taken out
+ * \param[in] reach the longest new edge allowed, in local spacings
+ * \param[in] max_edges loops longer than this are left open
+ * \param[in] true_border per vertex: on a true border, whose loop stays open;
+ *            empty: none
+ */
+HoleFilling
+fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<double>& spacing,
+                          const std::vector<CoconeTriangle>& cocone_triangles,
+                          std::vector<Triangle>& triangles,
+                          EdgeIncidences& incidences,
+                          std::vector<std::vector<int>>& loops,
+                          double reach,
+                          std::size_t max_edges,
+                          const std::vector<std::uint8_t>& true_border = {});
 
 /** \brief CGAL's advancing front reconstruction (Cohen-Steiner and Da; CGAL's
  * default plausibility: radius ratio bound 5, beta 0.52) of the points \a region
