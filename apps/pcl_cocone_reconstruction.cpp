@@ -18,7 +18,6 @@
 #include "screenshot.h"
 #include <unistd.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,7 +26,6 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 using namespace pcl::console;
@@ -353,20 +351,17 @@ main(int argc, char** argv)
                                    ? static_cast<std::size_t>(o.memory_mb * 1048576.0)
                                    : pcl::cocone::availableMemory();
     bool fits = true;
-    tile_points = pcl::cocone::automaticTilePoints(finite, budget, &fits);
-    const unsigned threads = o.threads > 0
-                                 ? static_cast<unsigned>(o.threads)
-                                 : std::max(1u, std::thread::hardware_concurrency());
-    if (tile_points > 0) {
-      tiles_in_flight =
-          pcl::cocone::automaticTilesInFlight(finite, budget, tile_points, threads);
+    const pcl::cocone::TilingOptions tiling = pcl::cocone::automaticTiling(
+        finite, budget, static_cast<unsigned>(o.threads), &fits);
+    tile_points = tiling.tile_points;
+    tiles_in_flight = tiling.tiles_in_flight;
+    if (tile_points > 0)
       print_info("%zu points do not fit %.0f MB in one piece: tiles of at most %zu "
                  "points, %u at a time.\n",
                  finite,
                  budget / 1048576.0,
                  tile_points,
                  tiles_in_flight);
-    }
     if (!fits)
       print_warn("Warning: %zu points likely need more than %.0f MB even in tiles of "
                  "%zu points (the cloud and the stitched mesh are held in memory).\n",

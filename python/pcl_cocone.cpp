@@ -19,7 +19,6 @@
 #include <cstring>
 #include <limits>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -42,14 +41,10 @@ resolveTiles(cocone::TilingOptions& tiling,
 {
   if (tiling.tile_points != AUTOMATIC_TILES)
     return;
-  const std::size_t memory = cocone::availableMemory();
-  tiling.tile_points = cocone::automaticTilePoints(points, memory);
-  tiling.tiles_in_flight = cocone::automaticTilesInFlight(
-      points,
-      memory,
-      tiling.tile_points,
-      parameters.threads > 0 ? parameters.threads
-                             : std::max(1u, std::thread::hardware_concurrency()));
+  const cocone::TilingOptions automatic =
+      cocone::automaticTiling(points, cocone::availableMemory(), parameters.threads);
+  tiling.tile_points = automatic.tile_points;
+  tiling.tiles_in_flight = automatic.tiles_in_flight;
 }
 
 /** What reconstruct() and detect_boundary() return. */

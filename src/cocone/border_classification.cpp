@@ -5,7 +5,7 @@
 
 #include <pcl/surface/cocone/border_classification.h>
 
-#include <Eigen/Eigenvalues>
+#include "loop_plane.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,55 +25,6 @@ circumradius(const Eigen::Vector3d& a,
   if (twice_area <= 0.0)
     return std::numeric_limits<double>::infinity();
   return (b - c).norm() * (a - c).norm() * (a - b).norm() / (2.0 * twice_area);
-}
-
-/** A loop projected onto its best-fit plane. */
-struct Projected {
-  Eigen::Vector3d centre, normal, u, w;
-  std::vector<Eigen::Vector2d> polygon;
-  double radius = 0.0; // farthest loop vertex from the centre
-
-  bool
-  contains(const Eigen::Vector3d& p) const
-  {
-    const Eigen::Vector3d q = p - centre;
-    if (q.norm() > radius || std::abs(q.dot(normal)) > 0.5 * radius)
-      return false;
-    const Eigen::Vector2d x(q.dot(u), q.dot(w));
-    bool inside = false; // crossings of a ray along +u
-    for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-      const Eigen::Vector2d &a = polygon[i], &b = polygon[j];
-      if ((a.y() > x.y()) != (b.y() > x.y()) &&
-          x.x() < a.x() + (b.x() - a.x()) * (x.y() - a.y()) / (b.y() - a.y()))
-        inside = !inside;
-    }
-    return inside;
-  }
-};
-
-Projected
-project(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& loop)
-{
-  Projected p;
-  p.centre.setZero();
-  for (const int v : loop)
-    p.centre += points[v];
-  p.centre /= static_cast<double>(loop.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const int v : loop) {
-    const Eigen::Vector3d q = points[v] - p.centre;
-    scatter += q * q.transpose();
-    p.radius = std::max(p.radius, q.norm());
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
-  p.normal = eigen.eigenvectors().col(0);
-  p.w = eigen.eigenvectors().col(1);
-  p.u = eigen.eigenvectors().col(2);
-  for (const int v : loop) {
-    const Eigen::Vector3d q = points[v] - p.centre;
-    p.polygon.emplace_back(q.dot(p.u), q.dot(p.w));
-  }
-  return p;
 }
 
 } // namespace
@@ -129,7 +80,7 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     auto& radii = rim_radii[l];
     if (loop.size() < 3 || loop.size() > max_edges || radii.empty())
       continue;
-    const Projected hole = project(points, loop);
+    const detail::LoopPlane hole = detail::projectLoop(points, loop);
     auto& candidates = near[l];
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()),

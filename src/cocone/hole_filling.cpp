@@ -14,6 +14,8 @@
 
 #include <Eigen/Dense>
 
+#include "loop_plane.h"
+
 #include <algorithm>
 #include <array>
 #include <iterator>
@@ -83,6 +85,41 @@ toCgal(const Eigen::Vector3d& p)
   return {p.x(), p.y(), p.z()};
 }
 
+/** Close each loop that may be closed (3 to \a max_edges edges, not on a true
+ * border) with the triangles \a patch_of(loop, patch) appends to patch, facing as the
+ * mesh (false: the loop stays open). The loops left open stay in \a loops; the
+ * incidences take in the triangles added. */
+template <typename PatchOf>
+HoleFilling
+closeLoops(std::vector<Triangle>& triangles,
+           EdgeIncidences& incidences,
+           std::vector<std::vector<int>>& loops,
+           std::size_t max_edges,
+           const std::vector<std::uint8_t>& true_border,
+           PatchOf patch_of)
+{
+  HoleFilling out;
+  const std::size_t before = triangles.size();
+  std::vector<std::vector<int>> open;
+  std::vector<Triangle> patch;
+  for (auto& loop : loops) {
+    patch.clear();
+    if (loop.size() < 3 || loop.size() > max_edges || onTrueBorder(loop, true_border) ||
+        !patch_of(loop, patch)) {
+      open.push_back(std::move(loop));
+      continue;
+    }
+    triangles.insert(triangles.end(), patch.begin(), patch.end());
+    ++out.holes;
+    out.triangles += patch.size();
+    out.rims.push_back(std::move(loop));
+  }
+  loops = std::move(open);
+  if (triangles.size() > before)
+    incidences.add(triangles, before);
+  return out;
+}
+
 } // namespace
 
 HoleFilling
@@ -95,20 +132,14 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       std::size_t max_edges,
                       const std::vector<std::uint8_t>& true_border)
 {
-  HoleFilling out;
-  const std::size_t before = triangles.size();
-  std::vector<std::vector<int>> open;
   std::vector<Kernel::Point_3> polyline, third;
-  std::vector<LoopTriangle> patch;
-  for (auto& loop : loops) {
+  std::vector<LoopTriangle> found;
+  const auto patch_of = [&](const std::vector<int>& loop,
+                            std::vector<Triangle>& patch) {
     const std::size_t k = loop.size();
-    if (k < 3 || k > max_edges || onTrueBorder(loop, true_border)) {
-      open.push_back(std::move(loop));
-      continue;
-    }
     // The hole runs against the loop, which has the mesh on its left: a triangle
     // of the hole's polygon with its corners in the hole's order faces as the mesh.
-    std::vector<int> hole(loop.rbegin(), loop.rend());
+    const std::vector<int> hole(loop.rbegin(), loop.rend());
     polyline.clear();
     third.clear();
     for (std::size_t i = 0; i < k; ++i) {
@@ -122,11 +153,11 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                                              : t[2];
       third.push_back(toCgal(points[c]));
     }
-    patch.clear();
+    found.clear();
     CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
         polyline,
         third,
-        std::back_inserter(patch),
+        std::back_inserter(found),
         CGAL::parameters::use_delaunay_triangulation(true).do_not_use_cubic_algorithm(
             true));
     // Plausible: every new edge short and not in the mesh yet.
@@ -139,8 +170,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       return withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0;
     };
     const auto plausible_patch = [&]() {
-      bool ok = patch.size() == k - 2;
-      for (const auto& t : patch)
+      bool ok = found.size() == k - 2;
+      for (const auto& t : found)
         ok = ok && plausible(t.v[0], t.v[1]) && plausible(t.v[1], t.v[2]) &&
              plausible(t.v[0], t.v[2]);
       return ok;
@@ -149,30 +180,22 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     if (!closed && k <= CUBIC_SEARCH_EDGES) {
       // The Delaunay faces of a loop round a corner or a crease may hold no short
       // patch; all triangles of the loop's vertices may (Liepa's cubic search).
-      patch.clear();
+      found.clear();
       CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
           polyline,
           third,
-          std::back_inserter(patch),
+          std::back_inserter(found),
           CGAL::parameters::use_delaunay_triangulation(false));
       closed = plausible_patch();
     }
-    if (!closed) {
-      open.push_back(std::move(loop));
-      continue;
-    }
-    for (auto t : patch) {
-      std::sort(t.v.begin(), t.v.end());
-      triangles.push_back({hole[t.v[0]], hole[t.v[1]], hole[t.v[2]]});
-    }
-    ++out.holes;
-    out.triangles += patch.size();
-    out.rims.push_back(loop);
-  }
-  loops = std::move(open);
-  if (triangles.size() > before)
-    incidences.add(triangles, before);
-  return out;
+    if (closed)
+      for (auto t : found) {
+        std::sort(t.v.begin(), t.v.end());
+        patch.push_back({hole[t.v[0]], hole[t.v[1]], hole[t.v[2]]});
+      }
+    return closed;
+  };
+  return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
 }
 
 namespace {
@@ -696,147 +719,125 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
   using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
   using Cdt = CGAL::
       Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
-  HoleFilling out;
+  if (loops.empty())
+    return HoleFilling();
   const std::size_t n = points.size();
-  const std::size_t before = triangles.size();
   std::vector<std::uint8_t> used(n, 0);
   for (const auto& t : triangles)
     for (const int v : t)
       used[v] = 1;
-  // Neighbours through the co-cone triangles, made when a loop needs them.
-  std::vector<std::vector<int>> neighbours;
-  std::vector<std::vector<int>> open;
-  std::vector<Kernel::Point_2> polygon;
-  std::vector<int> inner, stack;
-  std::vector<int> seen(n, -1);
-  for (std::size_t l = 0; l < loops.size(); ++l) {
-    std::vector<int>& loop = loops[l];
+  // Neighbours through the co-cone triangles (compressed rows), made when a loop
+  // needs them.
+  std::vector<std::size_t> first;
+  std::vector<int> neighbour;
+  const auto group_neighbours = [&]() {
+    first.assign(n + 1, 0);
+    for (const auto& t : cocone_triangles)
+      for (const int v : t.v)
+        first[v + 1] += 2;
+    for (std::size_t v = 0; v < n; ++v)
+      first[v + 1] += first[v];
+    neighbour.resize(first[n]);
+    std::vector<std::size_t> at(first.begin(), first.end() - 1);
+    for (const auto& t : cocone_triangles)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 1; j < 3; ++j)
+          neighbour[at[t.v[i]]++] = t.v[(i + j) % 3];
+  };
+  std::vector<int> seen(n, -1), inner, stack;
+  int stamp = 0;
+  const auto patch_of = [&](const std::vector<int>& loop,
+                            std::vector<Triangle>& patch) {
     const std::size_t k = loop.size();
-    if (k < 3 || k > max_edges || onTrueBorder(loop, true_border)) {
-      open.push_back(std::move(loop));
-      continue;
-    }
-    // The loop's plane, and a quadratic height over it fitted to the loop.
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    double radius = 0.0, rim_spacing = 0.0;
-    for (const int v : loop) {
-      centre += points[v];
-      rim_spacing += spacing[v];
-    }
-    centre /= static_cast<double>(k);
-    rim_spacing /= static_cast<double>(k);
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (const int v : loop) {
-      const Eigen::Vector3d q = points[v] - centre;
-      scatter += q * q.transpose();
-      radius = std::max(radius, q.norm());
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
-    const Eigen::Vector3d normal = eigen.eigenvectors().col(0),
-                          u = eigen.eigenvectors().col(2),
-                          w = eigen.eigenvectors().col(1);
-    const auto monomials = [&](const Eigen::Vector3d& q) {
-      const double x = q.dot(u) / radius, y = q.dot(w) / radius;
+    const detail::LoopPlane hole = detail::projectLoop(points, loop);
+    const auto point2 = [](const Eigen::Vector2d& x) {
+      return Kernel::Point_2(x.x(), x.y());
+    };
+    // The loop must project to a simple polygon (a hole, not a fold round a tip).
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 2; j < k; ++j)
+        if ((i != 0 || j != k - 1) &&
+            CGAL::do_intersect(Kernel::Segment_2(point2(hole.polygon[i]),
+                                                 point2(hole.polygon[(i + 1) % k])),
+                               Kernel::Segment_2(point2(hole.polygon[j]),
+                                                 point2(hole.polygon[(j + 1) % k]))))
+          return false;
+    // A quadratic height over the plane, fitted to the loop.
+    const auto monomials = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector2d x = hole.flat(p) / hole.radius;
       Eigen::Matrix<double, 6, 1> m;
-      m << 1.0, x, y, x * x, x * y, y * y;
+      m << 1.0, x.x(), x.y(), x.x() * x.x(), x.x() * x.y(), x.y() * x.y();
       return m;
     };
     Eigen::MatrixXd design(k, 6);
     Eigen::VectorXd height(k);
+    double rim_spacing = 0.0;
     for (std::size_t i = 0; i < k; ++i) {
-      const Eigen::Vector3d q = points[loop[i]] - centre;
-      design.row(static_cast<Eigen::Index>(i)) = monomials(q).transpose();
-      height(static_cast<Eigen::Index>(i)) = q.dot(normal);
+      const auto r = static_cast<Eigen::Index>(i);
+      design.row(r) = monomials(points[loop[i]]).transpose();
+      height(r) = (points[loop[i]] - hole.centre).dot(hole.normal);
+      rim_spacing += spacing[loop[i]] / static_cast<double>(k);
     }
     const Eigen::VectorXd fit = design.colPivHouseholderQr().solve(height);
-    const auto flat = [&](int v) {
-      const Eigen::Vector3d q = points[v] - centre;
-      return Kernel::Point_2(q.dot(u), q.dot(w));
-    };
-    // The loop must project to a simple polygon (a hole, not a fold round a tip).
-    polygon.clear();
-    for (const int v : loop)
-      polygon.push_back(flat(v));
-    bool simple = true;
-    for (std::size_t i = 0; i < k && simple; ++i)
-      for (std::size_t j = i + 2; j < k && simple; ++j)
-        if (i != 0 || j != k - 1)
-          simple =
-              !CGAL::do_intersect(Kernel::Segment_2(polygon[i], polygon[(i + 1) % k]),
-                                  Kernel::Segment_2(polygon[j], polygon[(j + 1) % k]));
-    const auto inside = [&](const Kernel::Point_2& p) {
-      return CGAL::bounded_side_2(polygon.begin(), polygon.end(), p, Kernel()) ==
-             CGAL::ON_BOUNDED_SIDE;
-    };
-    // The free samples inside, on the loop's surface (within a spacing of its
-    // height), reached from the loop through the co-cone triangles.
+    // The free samples over the hole within half a spacing of that height, reached
+    // from the loop through the co-cone triangles.
+    if (first.empty())
+      group_neighbours();
+    ++stamp;
     inner.clear();
-    if (simple) {
-      if (neighbours.empty()) {
-        neighbours.resize(n);
-        for (const auto& t : cocone_triangles)
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              if (i != j)
-                neighbours[t.v[i]].push_back(t.v[j]);
-      }
-      const int stamp = static_cast<int>(l);
-      stack.assign(loop.begin(), loop.end());
-      for (const int v : loop)
-        seen[v] = stamp;
-      while (!stack.empty()) {
-        const int v = stack.back();
-        stack.pop_back();
-        for (const int q : neighbours[v]) {
-          if (used[q] || seen[q] == stamp)
-            continue;
-          seen[q] = stamp;
-          const Eigen::Vector3d d = points[q] - centre;
-          if (d.norm() > radius || !inside(flat(q)) ||
-              std::abs(d.dot(normal) - monomials(d).dot(fit)) > 0.5 * rim_spacing)
-            continue;
-          inner.push_back(q);
-          stack.push_back(q);
-        }
+    stack.assign(loop.begin(), loop.end());
+    for (const int v : loop)
+      seen[v] = stamp;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (std::size_t i = first[v]; i < first[v + 1]; ++i) {
+        const int q = neighbour[i];
+        if (used[q] || seen[q] == stamp)
+          continue;
+        seen[q] = stamp;
+        if (!hole.contains(points[q]) ||
+            std::abs((points[q] - hole.centre).dot(hole.normal) -
+                     monomials(points[q]).dot(fit)) > 0.5 * rim_spacing)
+          continue;
+        inner.push_back(q);
+        stack.push_back(q);
       }
     }
-    if (inner.empty()) {
-      open.push_back(std::move(loop));
-      continue;
-    }
+    if (inner.empty())
+      return false;
     // The constrained Delaunay triangulation of the loop and the samples inside, in
     // the plane; its triangles inside the loop make the patch.
     Cdt cdt;
     std::vector<Cdt::Vertex_handle> rim;
     for (std::size_t i = 0; i < k; ++i) {
-      rim.push_back(cdt.insert(polygon[i]));
+      rim.push_back(cdt.insert(point2(hole.polygon[i])));
       rim.back()->info() = loop[i];
     }
     for (std::size_t i = 0; i < k; ++i)
       cdt.insert_constraint(rim[i], rim[(i + 1) % k]);
     for (const int q : inner)
-      cdt.insert(flat(q))->info() = q;
+      cdt.insert(point2(hole.flat(points[q])))->info() = q;
     // Distinct in the plane (no two projected onto one point), every new edge short
     // and new to the mesh.
-    bool ok = cdt.number_of_vertices() == k + inner.size();
-    std::vector<Triangle> patch;
-    for (auto f = cdt.finite_faces_begin(); ok && f != cdt.finite_faces_end(); ++f) {
-      if (!inside(CGAL::centroid(
-              f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point())))
+    if (cdt.number_of_vertices() != k + inner.size())
+      return false;
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+      const Eigen::Vector2d centroid = (hole.flat(points[f->vertex(0)->info()]) +
+                                        hole.flat(points[f->vertex(1)->info()]) +
+                                        hole.flat(points[f->vertex(2)->info()])) /
+                                       3.0;
+      if (!hole.inside(centroid))
         continue;
       const Triangle t{
           f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
-      for (int e = 0; e < 3 && ok; ++e) {
+      for (int e = 0; e < 3; ++e) {
         const int a = t[e], b = t[(e + 1) % 3];
-        const bool loop_edge = f->is_constrained((e + 2) % 3); // opposite corner
-        ok = loop_edge ||
-             (withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0);
+        if (!f->is_constrained((e + 2) % 3) && // the edge opposite corner e + 2
+            (!withinReach(points, spacing, reach, a, b) || incidences.find(a, b) >= 0))
+          return false;
       }
       patch.push_back(t);
-    }
-    if (!ok || patch.empty()) {
-      open.push_back(std::move(loop));
-      continue;
     }
     // Counter-clockwise in the plane; the patch runs against the loop, which has the
     // mesh on its left: turned over if it runs along it.
@@ -844,21 +845,14 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
     for (const auto& t : patch)
       for (int e = 0; e < 3; ++e)
         along = along || (t[e] == loop[0] && t[(e + 1) % 3] == loop[1]);
-    for (Triangle t : patch) {
-      if (along)
+    if (along)
+      for (Triangle& t : patch)
         std::swap(t[1], t[2]);
-      triangles.push_back(t);
-    }
     for (const int q : inner)
       used[q] = 1;
-    ++out.holes;
-    out.triangles += patch.size();
-    out.rims.push_back(std::move(loop));
-  }
-  loops = std::move(open);
-  if (triangles.size() > before)
-    incidences.add(triangles, before);
-  return out;
+    return !patch.empty();
+  };
+  return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
 }
 
 } // namespace cocone

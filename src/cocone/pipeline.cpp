@@ -34,6 +34,7 @@
 
 namespace pcl {
 namespace cocone {
+
 namespace {
 
 /** Stages 5-7 and the repair over stage 4's candidates: the oriented manifold
@@ -190,17 +191,21 @@ reconstruct(Triangulation& dt,
       return loop.size() <= parameters.max_hole_edges &&
              (true_border.empty() || !true_border[loop[0]]);
     };
-    const HoleFilling filled = fillUndersampledHoles(dt.points,
-                                                     spacing,
-                                                     result.triangles,
-                                                     incidences,
-                                                     result.border_loops,
-                                                     parameters.hole_reach,
-                                                     parameters.max_hole_edges,
-                                                     true_border);
-    counts.holes_filled = filled.holes;
-    counts.hole_triangles = filled.triangles;
-    result.filled_holes = filled.rims;
+    // Each step's holes counted and listed.
+    const auto record = [&](const HoleFilling& closed) {
+      counts.holes_filled += closed.holes;
+      counts.hole_triangles += closed.triangles;
+      result.filled_holes.insert(
+          result.filled_holes.end(), closed.rims.begin(), closed.rims.end());
+    };
+    record(fillUndersampledHoles(dt.points,
+                                 spacing,
+                                 result.triangles,
+                                 incidences,
+                                 result.border_loops,
+                                 parameters.hole_reach,
+                                 parameters.max_hole_edges,
+                                 true_border));
     // What the Delaunay patches leave (loops, points in no triangle) the original
     // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
     // coarsely for the flatness test. What those leave, the advancing front's may:
@@ -231,20 +236,16 @@ reconstruct(Triangulation& dt,
     };
     const auto fill_from = [&](const std::vector<Triangle>& other,
                                std::size_t band_per_edge) {
-      const HoleFilling patched = fillHolesFromMesh(dt.points,
-                                                    spacing,
-                                                    other,
-                                                    result.triangles,
-                                                    incidences,
-                                                    result.border_loops,
-                                                    parameters.hole_reach,
-                                                    parameters.max_hole_edges,
-                                                    band_per_edge,
-                                                    true_border);
-      counts.holes_filled += patched.holes;
-      counts.hole_triangles += patched.triangles;
-      result.filled_holes.insert(
-          result.filled_holes.end(), patched.rims.begin(), patched.rims.end());
+      record(fillHolesFromMesh(dt.points,
+                               spacing,
+                               other,
+                               result.triangles,
+                               incidences,
+                               result.border_loops,
+                               parameters.hole_reach,
+                               parameters.max_hole_edges,
+                               band_per_edge,
+                               true_border));
     };
     std::vector<std::uint8_t> region = open_region(PLAIN_COCONE_RINGS, true);
     if (!region.empty())
@@ -270,19 +271,15 @@ reconstruct(Triangulation& dt,
       result.filled_holes.erase(gone, result.filled_holes.end());
     }
     // Holes round samples no mesh made a surface of, closed through them.
-    const HoleFilling through = fillHolesWithInnerSamples(dt.points,
-                                                          spacing,
-                                                          cells.triangles,
-                                                          result.triangles,
-                                                          incidences,
-                                                          result.border_loops,
-                                                          parameters.hole_reach,
-                                                          parameters.max_hole_edges,
-                                                          true_border);
-    counts.holes_filled += through.holes;
-    counts.hole_triangles += through.triangles;
-    result.filled_holes.insert(
-        result.filled_holes.end(), through.rims.begin(), through.rims.end());
+    record(fillHolesWithInnerSamples(dt.points,
+                                     spacing,
+                                     cells.triangles,
+                                     result.triangles,
+                                     incidences,
+                                     result.border_loops,
+                                     parameters.hole_reach,
+                                     parameters.max_hole_edges,
+                                     true_border));
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

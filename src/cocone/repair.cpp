@@ -497,30 +497,53 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
   return added;
 }
 
+namespace {
+
+/** Drop the components of the mesh that \a drop_component(incidences, component,
+ * count) marks (one flag per component, from the triangles' component ids). */
+template <typename Mark>
 std::size_t
-dropRibbons(std::vector<Triangle>& triangles,
-            std::size_t num_vertices,
-            EdgeIncidences* incidences)
+dropComponents(std::vector<Triangle>& triangles,
+               EdgeIncidences* incidences,
+               const Mark& drop_component)
 {
   std::size_t count = 0;
   EdgeIncidences grouped;
   const EdgeIncidences& inc = incidencesOf(triangles, incidences, grouped);
   const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
-  std::vector<std::uint8_t> on_border(num_vertices, 0);
-  for (std::size_t e = 0; e < inc.edges.size(); ++e)
-    if (inc.count(e) == 1)
-      on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] = 1;
-  std::vector<std::uint8_t> inner(count, 0);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (const int v : triangles[t])
-      if (!on_border[v])
-        inner[component[t]] = 1;
+  const std::vector<std::uint8_t> marked = drop_component(inc, component, count);
   std::vector<std::uint8_t> drop(triangles.size(), 0);
   for (std::size_t t = 0; t < triangles.size(); ++t)
-    drop[t] = !inner[component[t]];
+    drop[t] = marked[component[t]];
   if (incidences && &inc == &grouped)
     *incidences = std::move(grouped);
   return compact(triangles, drop, incidences);
+}
+
+} // namespace
+
+std::size_t
+dropRibbons(std::vector<Triangle>& triangles,
+            std::size_t num_vertices,
+            EdgeIncidences* incidences)
+{
+  return dropComponents(triangles,
+                        incidences,
+                        [&](const EdgeIncidences& inc,
+                            const std::vector<int>& component,
+                            std::size_t count) {
+                          std::vector<std::uint8_t> on_border(num_vertices, 0);
+                          for (std::size_t e = 0; e < inc.edges.size(); ++e)
+                            if (inc.count(e) == 1)
+                              on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] =
+                                  1;
+                          std::vector<std::uint8_t> ribbon(count, 1);
+                          for (std::size_t t = 0; t < triangles.size(); ++t)
+                            for (const int v : triangles[t])
+                              if (!on_border[v])
+                                ribbon[component[t]] = 0;
+                          return ribbon;
+                        });
 }
 
 std::size_t
@@ -529,28 +552,24 @@ dropSpecks(std::vector<Triangle>& triangles,
            std::size_t min_vertices,
            EdgeIncidences* incidences)
 {
-  std::size_t count = 0;
-  EdgeIncidences grouped;
-  const EdgeIncidences& inc = incidencesOf(triangles, incidences, grouped);
-  const std::vector<int> component = triangleComponents(inc, triangles.size(), &count);
-  // Vertices per component: a vertex is in one component (its triangles share it).
-  std::vector<int> component_of(num_vertices, -1);
-  std::vector<std::size_t> vertices(count, 0);
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (const int v : triangles[t])
-      if (component_of[v] < 0) {
-        component_of[v] = component[t];
-        ++vertices[component[t]];
-      }
-  std::vector<std::uint8_t> drop(triangles.size(), 0);
-  bool any = false;
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    drop[t] = vertices[component[t]] < min_vertices;
-    any = any || drop[t];
-  }
-  if (incidences && &inc == &grouped)
-    *incidences = std::move(grouped);
-  return any ? compact(triangles, drop, incidences) : 0;
+  return dropComponents(
+      triangles,
+      incidences,
+      [&](const EdgeIncidences&, const std::vector<int>& component, std::size_t count) {
+        // Vertices per component: a vertex is in one (its fan is one).
+        std::vector<std::uint8_t> counted(num_vertices, 0);
+        std::vector<std::size_t> vertices(count, 0);
+        for (std::size_t t = 0; t < triangles.size(); ++t)
+          for (const int v : triangles[t])
+            if (!counted[v]) {
+              counted[v] = 1;
+              ++vertices[component[t]];
+            }
+        std::vector<std::uint8_t> speck(count, 0);
+        for (std::size_t c = 0; c < count; ++c)
+          speck[c] = vertices[c] < min_vertices;
+        return speck;
+      });
 }
 
 } // namespace cocone

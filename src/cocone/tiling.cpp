@@ -864,6 +864,23 @@ automaticTilesInFlight(std::size_t points,
       std::max(1.0, std::min(fit, static_cast<double>(std::max(1u, threads)))));
 }
 
+TilingOptions
+automaticTiling(std::size_t points,
+                std::size_t memory,
+                unsigned int threads,
+                bool* fits)
+{
+  TilingOptions tiling;
+  tiling.tile_points = automaticTilePoints(points, memory, fits);
+  if (tiling.tile_points > 0)
+    tiling.tiles_in_flight = automaticTilesInFlight(
+        points,
+        memory,
+        tiling.tile_points,
+        threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency()));
+  return tiling;
+}
+
 std::vector<int>
 TilePlan::tilePoints(std::size_t tile) const
 {

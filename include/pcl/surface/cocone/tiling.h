@@ -89,6 +89,17 @@ struct TilingOptions {
   unsigned int tiles_in_flight = 0;
 };
 
+/** \brief The tiling for a cloud of \a points within \a memory bytes:
+ * automaticTilePoints(), and as many tiles at once as automaticTilesInFlight() fits
+ * with \a threads threads (0: one per processor); one piece: the default options.
+ * What the command-line tool's and the Python bindings' tile_points "auto" use.
+ * \param[out] fits if given, whether the plan fits \a memory */
+TilingOptions
+automaticTiling(std::size_t points,
+                std::size_t memory,
+                unsigned int threads,
+                bool* fits = nullptr);
+
 /** \brief What runTiled() did, beyond the Result. */
 struct TilingReport {
   /** Number of tiles (1: one piece). */
