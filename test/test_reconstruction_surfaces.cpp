@@ -811,6 +811,62 @@ TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
               0.0);
 }
 
+TEST(HoleFilling, PatchWithAHoleOfItsOwnIsClosedByDelaunayPatches)
+{
+  // A square grid of unit spacing with a round hole, and another mesh of the same
+  // triangles that has a hole of its own inside it: the fan of the middle vertex.
+  // The other mesh's patch stops at that hole, which a Delaunay patch of its
+  // hexagon closes, so the grid's hole closes without the middle vertex; the grid's
+  // outer border stays.
+  const int n = 16;
+  std::vector<Eigen::Vector3d> points;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      points.emplace_back(i, j, 0.0);
+  const int middle = (n / 2) * n + n / 2;
+  std::vector<pcl::cocone::Triangle> mesh, other;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = j * n + i, b = a + 1, c = a + n + 1, d = a + n;
+      for (const pcl::cocone::Triangle& t :
+           {pcl::cocone::Triangle{a, b, c}, pcl::cocone::Triangle{a, c, d}}) {
+        const Eigen::Vector3d centroid =
+            (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0 - points[middle];
+        if (centroid.norm() >= 2.2)
+          mesh.push_back(t);
+        if (std::find(t.begin(), t.end(), middle) == t.end())
+          other.push_back(t);
+      }
+    }
+  const std::vector<double> spacing(points.size(), 1.0);
+  pcl::cocone::EdgeIncidences incidences(mesh);
+  auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+  ASSERT_EQ(loops.size(), 2u);
+
+  const auto filled = pcl::cocone::fillHolesFromMesh(
+      points, spacing, other, mesh, incidences, loops, 2.75, 1000, 0);
+  EXPECT_EQ(filled.holes, 1u);
+  const auto topology = pcl::cocone::analyzeMesh(mesh, points.size());
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.euler, 1); // a disk
+  EXPECT_EQ(topology.components, 1u);
+  EXPECT_EQ(topology.boundary_edges, 4u * (n - 1));
+  // The middle vertex's six triangles become the hexagon's four.
+  EXPECT_EQ(mesh.size(), 2u * (n - 1) * (n - 1) - 2u);
+  for (const auto& t : mesh) {
+    EXPECT_EQ(std::find(t.begin(), t.end(), middle), t.end());
+    EXPECT_GT((points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).z(),
+              0.0);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_LE((points[t[c]] - points[t[(c + 1) % 3]]).norm(), 2.75);
+  }
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0].size(), 4u * (n - 1));
+  const pcl::cocone::EdgeIncidences fresh(mesh);
+  EXPECT_EQ(incidences.edges, fresh.edges);
+  EXPECT_EQ(incidences.triangle, fresh.triangle);
+}
+
 TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)
 {
   // Coarse random samples: cubes of 800 and 3,000 points (sharp edges and corners;

@@ -20,6 +20,7 @@
 #include <array>
 #include <iterator>
 #include <limits>
+#include <numeric>
 #include <set>
 #include <utility>
 
@@ -302,6 +303,15 @@ eulerCharacteristic(const std::vector<Triangle>& triangles, const Ids& ids)
   return v - e + static_cast<long>(ids.size());
 }
 
+/** Euler characteristic of all of \a triangles. */
+long
+eulerCharacteristic(const std::vector<Triangle>& triangles)
+{
+  std::vector<int> all(triangles.size());
+  std::iota(all.begin(), all.end(), 0);
+  return eulerCharacteristic(triangles, all);
+}
+
 } // namespace
 
 HoleFilling
@@ -332,7 +342,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> in_patch(other.size(), -1), in_band(before, -1);
   int patch_stamp = -1, band_stamp = -1;
   std::vector<int> band, patch, stack, blamed;
-  std::vector<DirectedEdge> rim, band_border;
+  std::vector<DirectedEdge> rim, band_border, cut;
+  std::vector<Triangle> piece, context;
   std::vector<std::array<int, 2>> rim_keys, patch_edges;
   std::vector<int> rim_vertices, band_uses, taken_vertices;
   std::vector<std::vector<int>> absorbed; // the loops a patch closes
@@ -477,14 +488,28 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
           if (sameVertices(other[theirs.triangle[j]], mesh.triangles()[t]))
             ++(theirs.forward[j] == (e[0] < e[1]) ? same : reversed);
       }
+      // A triangle of the other mesh the patch may hold: its edges within the reach.
+      const auto fits = [&](int t) {
+        for (int c = 0; c < 3; ++c) {
+          const int u = other[t][c], v = other[t][(c + 1) % 3];
+          if (!on_rim(u, v) && !short_edge(u, v))
+            return false;
+        }
+        return true;
+      };
       // Seeds: at each rim edge the other mesh's triangle on the side away from the
-      // mesh; grown across the other mesh's inner edges. A border of the other mesh,
-      // an edge longer than the reach or a triangle taken already ends the attempt.
+      // mesh; grown across the other mesh's inner edges. Where the other mesh has a
+      // hole too (a border, a triangle with an edge beyond the reach) the patch stops
+      // at a cut edge, which the Delaunay patches must then close (a rim edge without
+      // a seed is one, with the mesh's triangle there as the context the patches
+      // face by); a triangle taken already ends the attempt.
       const auto grow = [&](int flip) {
         ++patch_stamp;
         taken_vertices.clear();
         patch.clear();
         stack.clear();
+        cut.clear();
+        context.clear();
         for (const auto& e : rim) {
           const auto j0 = theirs.find(e[0], e[1]);
           int seed = -1;
@@ -498,6 +523,16 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
           }
           if (taken[seed])
             return false;
+          if (!fits(seed)) {
+            // As the other mesh faces, the mesh's triangle at ab runs against a
+            // seed there: it runs ab if the patch is not turned over.
+            Triangle t = mesh.triangles()[mesh.traversing(e[0], e[1])];
+            if (flip == 1)
+              std::swap(t[1], t[2]);
+            cut.push_back(flip == 1 ? DirectedEdge{e[1], e[0]} : e);
+            context.push_back(t);
+            continue;
+          }
           if (in_patch[seed] != patch_stamp) {
             in_patch[seed] = patch_stamp;
             stack.push_back(seed);
@@ -521,7 +556,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
             if (on_rim(u, v))
               continue;
             const auto e = theirs.find(u, v);
-            if (theirs.count(e) != 2 || !short_edge(u, v))
+            if (theirs.count(e) > 2)
               return false;
             // The patch does not cross the mesh: where it would, the mesh's triangles
             // there are to join the band.
@@ -529,12 +564,20 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
             blame_edge(u, v);
             if (blamed.size() > blamed_before)
               continue;
+            if (theirs.count(e) == 1) {
+              cut.push_back({u, v});
+              continue;
+            }
             for (std::size_t j = theirs.first[e]; j < theirs.first[e + 1]; ++j) {
               const int next = theirs.triangle[j];
               if (next == t || in_patch[next] == patch_stamp)
                 continue;
               if (taken[next])
                 return false;
+              if (!fits(next)) {
+                cut.push_back({u, v});
+                continue;
+              }
               in_patch[next] = patch_stamp;
               stack.push_back(next);
             }
@@ -583,12 +626,63 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       }
       if (!ok)
         break;
+      // The patch's own holes, as the other mesh faces, closed by Delaunay patches
+      // of their loops (each vertex starts one cut edge at most: simple loops); the
+      // new edges not the mesh's.
+      std::sort(patch.begin(), patch.end());
+      piece.clear();
+      for (const int t : patch)
+        piece.push_back(other[t]);
+      if (!cut.empty()) {
+        std::sort(cut.begin(), cut.end());
+        for (std::size_t i = 1; i < cut.size() && ok; ++i)
+          ok = cut[i][0] != cut[i - 1][0];
+        if (!ok)
+          break;
+        std::vector<std::vector<int>> cut_loops;
+        std::vector<std::uint8_t> walked(cut.size(), 0);
+        for (std::size_t i = 0; i < cut.size() && ok; ++i) {
+          if (walked[i])
+            continue;
+          cut_loops.emplace_back();
+          for (std::size_t j = i; !walked[j];) {
+            walked[j] = 1;
+            cut_loops.back().push_back(cut[j][0]);
+            const auto next = std::lower_bound(
+                cut.begin(),
+                cut.end(),
+                DirectedEdge{cut[j][1], std::numeric_limits<int>::min()});
+            if (next == cut.end() || (*next)[0] != cut[j][1]) {
+              ok = false;
+              break;
+            }
+            j = static_cast<std::size_t>(next - cut.begin());
+          }
+        }
+        if (!ok)
+          break;
+        const std::size_t own = piece.size();
+        piece.insert(piece.end(), context.begin(), context.end());
+        EdgeIncidences piece_incidences(piece);
+        fillUndersampledHoles(
+            points, spacing, piece, piece_incidences, cut_loops, reach, max_edges, {});
+        piece.erase(piece.begin() + own, piece.begin() + own + context.size());
+        ok = cut_loops.empty();
+        for (std::size_t t = own; t < piece.size() && ok; ++t)
+          for (int c = 0; c < 3 && ok; ++c) {
+            const std::size_t blamed_before = blamed.size();
+            blame_edge(piece[t][c], piece[t][(c + 1) % 3]);
+            ok = blamed.size() == blamed_before;
+          }
+        if (!ok)
+          break;
+      }
       // A patch bounded by the rim that stands for the band with its holes capped:
       // the same Euler characteristic, so the genus stays.
       patch_edges.clear();
-      for (const int t : patch)
+      for (const Triangle& t : piece)
         for (int c = 0; c < 3; ++c)
-          patch_edges.push_back(edgeKey(other[t][c], other[t][(c + 1) % 3]));
+          patch_edges.push_back(edgeKey(t[c], t[(c + 1) % 3]));
       std::sort(patch_edges.begin(), patch_edges.end());
       std::size_t border = 0;
       for (std::size_t i = 0; i < patch_edges.size() && ok;) {
@@ -600,24 +694,22 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         i = j;
       }
       ok = ok && border == rim.size() &&
-           eulerCharacteristic(other, patch) ==
-               eulerCharacteristic(mesh.triangles(), band) +
-                   static_cast<long>(absorbed.size());
+           eulerCharacteristic(piece) == eulerCharacteristic(mesh.triangles(), band) +
+                                             static_cast<long>(absorbed.size());
       if (!ok)
         break;
       for (const int t : band)
         mesh.kill(t);
-      std::sort(patch.begin(), patch.end());
-      for (const int t : patch) {
+      for (const int t : patch)
         taken[t] = 1;
-        Triangle added_triangle = other[t];
+      for (Triangle added_triangle : piece) {
         if (flip == 1)
           std::swap(added_triangle[1], added_triangle[2]);
         mesh.add(added_triangle);
       }
       in_band.resize(mesh.triangles().size(), -1);
       out.holes += absorbed.size();
-      out.triangles += patch.size();
+      out.triangles += piece.size();
       out.rims.insert(out.rims.end(), absorbed.begin(), absorbed.end());
       changed = true;
       closed = true;
@@ -653,7 +745,6 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   // triangles): an open patch along a true border keeps a loop no short patch
   // closes.
   std::vector<int> component(other.size(), -1);
-  std::vector<Triangle> piece;
   for (std::size_t s = 0; s < other.size(); ++s) {
     if (component[s] >= 0 || taken[s])
       continue;
