@@ -623,6 +623,28 @@ TEST(Repair, OrientsEachComponentWithAnyThreadCount)
   EXPECT_EQ(topology.components, 3u);
 }
 
+TEST(Reconstruction, SameOutputWhateverRanBefore)
+{
+  // A coarse random tube, whose holes the advancing front's patches close: CGAL's
+  // advancing front broke ties by the addresses of its cells and front edges, so
+  // the mesh changed with what the process had allocated before (here: another
+  // reconstruction) and with the thread count.
+  const auto s = cocone_test::tube(options(7000, 0.0, 1.0, false), 0.04);
+  Parameters one;
+  one.threads = 1;
+  const Result a = pcl::cocone::run(s.points, one, pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_GT(a.counts.holes_filled, 0u);
+  const auto other = cocone_test::tube(options(10000, 0.0, 1.0, false), 0.015);
+  pcl::cocone::run(other.points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  for (const unsigned threads : {1u, 2u}) {
+    Parameters p;
+    p.threads = threads;
+    const Result b = pcl::cocone::run(s.points, p, pcl::cocone::Stages::RECONSTRUCTION);
+    EXPECT_EQ(b.polygons, a.polygons) << threads << " threads";
+    EXPECT_EQ(b.counts.holes_filled, a.counts.holes_filled) << threads << " threads";
+  }
+}
+
 TEST(Reconstruction, Deterministic)
 {
   const auto s = cocone_test::monkeySaddle(options(5000, 0.05));
@@ -865,6 +887,108 @@ TEST(HoleFilling, PatchWithAHoleOfItsOwnIsClosedByDelaunayPatches)
   const pcl::cocone::EdgeIncidences fresh(mesh);
   EXPECT_EQ(incidences.edges, fresh.edges);
   EXPECT_EQ(incidences.triangle, fresh.triangle);
+}
+
+TEST(HoleFilling, HoleWindingRoundATubeIsClosedByTheAdvancingFront)
+{
+  // A thin torus (about 12 samples round the tube) with a hole that winds two thirds
+  // of the way round the tube along 14 spacings of it: the band round the hole is
+  // no disk, so no patch is bounded by its loop, but the advancing front over the
+  // whole piece and the samples in the hole closes it with the torus's genus. The same
+  // hole on a true border, or longer than max_edges, stays; and a small hole in the
+  // same piece is left to the patches (the piece is much larger than its hole).
+  const auto s = cocone_test::torus(cocone_test::options(1000), 1.0, 0.1);
+  const auto full = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_EQ(pcl::cocone::analyzeMesh(full.triangles, full.vertices).euler, 0);
+  std::vector<Eigen::Vector3d> points(full.vertices);
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    if (full.vertex_of_input[i] >= 0)
+      points[full.vertex_of_input[i]] = s.points[i];
+  const std::vector<double> spacing(points.size(), s.spacing);
+  // The co-cone triangles: those of the whole torus, so the samples in the hole
+  // are next to the piece.
+  std::vector<pcl::cocone::CoconeTriangle> cocone;
+  for (auto t : full.triangles) {
+    std::sort(t.begin(), t.end());
+    cocone.push_back({t, 7});
+  }
+  // Cut the triangles whose centroid is in the hole: along the tube within `along`
+  // radians of the x axis, round it where the tube faces outwards (cos > -0.5).
+  const auto cut = [&](double along) {
+    std::vector<pcl::cocone::Triangle> mesh;
+    for (const auto& t : full.triangles) {
+      const Eigen::Vector3d c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+      const double phi = std::atan2(c.y(), c.x());
+      const double outward = std::hypot(c.x(), c.y()) - 1.0;
+      if (std::abs(phi) >= along || outward < -0.5 * 0.1)
+        mesh.push_back(t);
+    }
+    return mesh;
+  };
+  const auto close = [&](std::vector<pcl::cocone::Triangle>& mesh,
+                         std::size_t max_edges,
+                         bool on_true_border) {
+    pcl::cocone::EdgeIncidences incidences(mesh);
+    auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+    EXPECT_EQ(loops.size(), 1u);
+    std::vector<std::uint8_t> true_border;
+    if (on_true_border) {
+      true_border.assign(points.size(), 0);
+      for (const int v : loops.at(0))
+        true_border[v] = 1;
+    }
+    const auto closed = pcl::cocone::closePiecesWithAdvancingFront(
+        points, spacing, cocone, mesh, incidences, loops, 2.75, max_edges, true_border);
+    const pcl::cocone::EdgeIncidences fresh(mesh);
+    EXPECT_EQ(incidences.edges, fresh.edges);
+    EXPECT_EQ(loops, pcl::cocone::boundaryLoops(fresh, points.size()));
+    return closed;
+  };
+
+  auto mesh = cut(0.45);
+  const auto loop_edges =
+      pcl::cocone::boundaryLoops(pcl::cocone::EdgeIncidences(mesh), points.size())
+          .at(0)
+          .size();
+  std::printf("[ measured ] hole winding round the tube: %zu edges, %zu vertices\n",
+              loop_edges,
+              pcl::cocone::analyzeMesh(mesh, points.size()).vertices);
+  {
+    auto patched = mesh;
+    pcl::cocone::EdgeIncidences incidences(patched);
+    auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+    EXPECT_EQ(pcl::cocone::fillUndersampledHoles(
+                  points, spacing, patched, incidences, loops, 2.75, 1000)
+                  .holes,
+              0u);
+  }
+  for (const bool on_true_border : {true, false})
+    for (const std::size_t max_edges : {loop_edges - 1, loop_edges}) {
+      SCOPED_TRACE(on_true_border);
+      SCOPED_TRACE(max_edges);
+      auto closing = mesh;
+      const auto closed = close(closing, max_edges, on_true_border);
+      if (on_true_border || max_edges < loop_edges) {
+        EXPECT_EQ(closed.holes, 0u);
+        EXPECT_EQ(closing, mesh);
+        continue;
+      }
+      EXPECT_EQ(closed.holes, 1u);
+      ASSERT_EQ(closed.rims.size(), 1u);
+      EXPECT_EQ(closed.rims[0].size(), loop_edges);
+      const auto topology = pcl::cocone::analyzeMesh(closing, points.size());
+      EXPECT_TRUE(topology.manifold());
+      EXPECT_EQ(topology.boundary_edges, 0u);
+      EXPECT_EQ(topology.components, 1u);
+      EXPECT_EQ(topology.euler, 0);
+      for (const auto& t : closing)
+        for (int c = 0; c < 3; ++c)
+          EXPECT_LE((points[t[c]] - points[t[(c + 1) % 3]]).norm(), 2.75 * s.spacing);
+    }
+  // A hole of a few triangles: the piece is far larger than its loop.
+  auto small = cut(0.05);
+  EXPECT_EQ(close(small, 1000, false).holes, 0u);
 }
 
 TEST(HoleFilling, CoarseClosedSurfacesComeOutClosed)

@@ -7,36 +7,129 @@
  */
 
 #include <pcl/surface/cocone/hole_filling.h>
+#include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/repair.h>
 
 #include <CGAL/Advancing_front_surface_reconstruction.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <algorithm>
 #include <array>
 #include <iterator>
+#include <numeric>
 
 namespace pcl {
 namespace cocone {
 
-std::vector<Triangle>
-advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<std::uint8_t>& region,
-                   int threads)
-{
-  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-  std::vector<Point> p;
-  std::vector<int> vertex;
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (region[v]) {
-      p.emplace_back(points[v].x(), points[v].y(), points[v].z());
-      vertex.push_back(static_cast<int>(v));
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+/** CGAL's advancing front keeps its front in a std::set of (priority, address of
+ * the edge's record): where priorities tie (all its stand-by candidates share one
+ * value) the heap's addresses decide which edge grows first, so its output changed
+ * with what the process allocated before (another cloud, another thread count).
+ * The same vertex base with the front ordered by (priority, the edge's input ids):
+ * the same points give the same mesh. */
+template <typename Vb = CGAL::Triangulation_vertex_base_3<Kernel>>
+class FrontVertex
+: public CGAL::Advancing_front_surface_reconstruction_vertex_base_3<Kernel, Vb> {
+  using Base = CGAL::Advancing_front_surface_reconstruction_vertex_base_3<Kernel, Vb>;
+
+public:
+  template <typename Tds>
+  struct Rebind_TDS {
+    using Other = FrontVertex<typename Vb::template Rebind_TDS<Tds>::Other>;
+  };
+  using Base::Base;
+
+  /** A front edge: its priority and its record (an edge of the triangulation). */
+  struct Radius_ptr_type {
+    typename Base::criteria first;
+    typename Base::IO_edge_type* second;
+
+    Radius_ptr_type(typename Base::criteria priority, typename Base::IO_edge_type* edge)
+    : first(priority), second(edge)
+    {}
+
+    /** The edge's vertices' input ids, smaller first. */
+    std::pair<std::size_t, std::size_t>
+    ids() const
+    {
+      const auto& e = second->first.first; // (cell, i, j)
+      const std::size_t a = e.first->vertex(e.second)->info();
+      const std::size_t b = e.first->vertex(e.third)->info();
+      return std::minmax(a, b);
     }
+
+    friend bool
+    operator<(const Radius_ptr_type& a, const Radius_ptr_type& b)
+    {
+      if (a.first != b.first)
+        return a.first < b.first;
+      // The address last: two records of one edge did not tie in any test.
+      const auto ia = a.ids(), ib = b.ids();
+      return ia != ib ? ia < ib : a.second < b.second;
+    }
+  };
+};
+
+/** CGAL's advancing front cell with a time stamp: the triangulation then orders
+ * cell handles by creation, not by address, where it reports each facet once
+ * (from the cell that compares less), and so the facet the front starts from. */
+template <typename Cb = CGAL::Delaunay_triangulation_cell_base_3<Kernel>>
+class FrontCell
+: public CGAL::Advancing_front_surface_reconstruction_cell_base_3<Kernel, Cb> {
+  using Base = CGAL::Advancing_front_surface_reconstruction_cell_base_3<Kernel, Cb>;
+  std::size_t time_stamp_ = static_cast<std::size_t>(-1);
+
+public:
+  template <typename Tds>
+  struct Rebind_TDS {
+    using Other = FrontCell<typename Cb::template Rebind_TDS<Tds>::Other>;
+  };
+  using Base::Base;
+  using Has_timestamp = CGAL::Tag_true;
+
+  std::size_t
+  time_stamp() const
+  {
+    return time_stamp_;
+  }
+
+  void
+  set_time_stamp(const std::size_t& stamp)
+  {
+    time_stamp_ = stamp;
+  }
+};
+
+using FrontTriangulation = CGAL::Delaunay_triangulation_3<
+    Kernel,
+    CGAL::Triangulation_data_structure_3<FrontVertex<>, FrontCell<>>>;
+
+/** CGAL's advancing front over the listed vertices, oriented. */
+std::vector<Triangle>
+advancingFront(const std::vector<Eigen::Vector3d>& points,
+               const std::vector<int>& vertex,
+               int threads)
+{
   std::vector<Triangle> triangles;
-  if (p.size() < 4)
+  if (vertex.size() < 4)
     return triangles;
+  // As CGAL::advancing_front_surface_reconstruction() with its default parameters,
+  // on FrontTriangulation.
+  std::vector<std::pair<Kernel::Point_3, std::size_t>> p;
+  p.reserve(vertex.size());
+  for (std::size_t i = 0; i < vertex.size(); ++i) {
+    const Eigen::Vector3d& q = points[vertex[i]];
+    p.emplace_back(Kernel::Point_3(q.x(), q.y(), q.z()), i);
+  }
+  FrontTriangulation dt(p.begin(), p.end());
+  CGAL::Advancing_front_surface_reconstruction<FrontTriangulation> front(dt);
+  front.run();
   std::vector<std::array<std::size_t, 3>> facets;
-  CGAL::advancing_front_surface_reconstruction(
-      p.begin(), p.end(), std::back_inserter(facets));
+  CGAL::write_triple_indices(std::back_inserter(facets), front);
   triangles.reserve(facets.size());
   for (const auto& f : facets)
     triangles.push_back({vertex[f[0]], vertex[f[1]], vertex[f[2]]});
@@ -44,6 +137,192 @@ advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
   RepairCounts counts;
   repairManifold(points, triangles, counts, threads);
   return triangles;
+}
+
+/** analyzeMesh() of triangles on the listed vertices (ascending), in time of their
+ * number. */
+MeshTopology
+analyzeOn(const std::vector<int>& vertex, std::vector<Triangle> triangles)
+{
+  for (auto& t : triangles)
+    for (int& v : t)
+      v = static_cast<int>(std::lower_bound(vertex.begin(), vertex.end(), v) -
+                           vertex.begin());
+  return analyzeMesh(triangles, vertex.size());
+}
+
+} // namespace
+
+std::vector<Triangle>
+advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<std::uint8_t>& region,
+                   int threads)
+{
+  std::vector<int> vertex;
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (region[v])
+      vertex.push_back(static_cast<int>(v));
+  return advancingFront(points, vertex, threads);
+}
+
+HoleFilling
+closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<double>& spacing,
+                              const std::vector<CoconeTriangle>& cocone_triangles,
+                              std::vector<Triangle>& triangles,
+                              EdgeIncidences& incidences,
+                              std::vector<std::vector<int>>& loops,
+                              double reach,
+                              std::size_t max_edges,
+                              const std::vector<std::uint8_t>& true_border,
+                              int threads)
+{
+  HoleFilling out;
+  if (loops.empty())
+    return out;
+  const auto n = static_cast<int>(points.size());
+  // The pieces: one fan per vertex, so triangles sharing a vertex share an edge.
+  std::vector<int> piece(n);
+  std::iota(piece.begin(), piece.end(), 0);
+  const auto root = [&](int v) {
+    while (piece[v] != v)
+      v = piece[v] = piece[piece[v]];
+    return v;
+  };
+  std::vector<std::uint8_t> used(n, 0);
+  for (const auto& t : triangles)
+    for (int c = 0; c < 3; ++c) {
+      used[t[c]] = 1;
+      piece[root(t[c])] = root(t[0]);
+    }
+  std::vector<std::size_t> size(n, 0);
+  for (int v = 0; v < n; ++v)
+    size[root(v)] += used[v];
+  // A candidate: a piece whose loops are all undersampled holes, together about
+  // as large as the piece (its vertices at most the square of their edges). A
+  // piece much larger than its holes closes them locally (the patches) or not at
+  // all; this also bounds the advancing front's cost.
+  std::vector<int> roots;
+  std::vector<std::size_t> edges(n, 0);
+  std::vector<std::uint8_t> rejected(n, 0);
+  for (const auto& loop : loops) {
+    const int r = root(loop[0]);
+    roots.push_back(r);
+    edges[r] += loop.size();
+    rejected[r] |=
+        loop.size() > max_edges ||
+        (!true_border.empty() &&
+         std::any_of(loop.begin(), loop.end(), [&](int v) { return true_border[v]; }));
+  }
+  std::vector<int> candidates;
+  for (const int r : roots)
+    if (!rejected[r] &&
+        static_cast<double>(size[r]) <=
+            static_cast<double>(edges[r]) * static_cast<double>(edges[r]))
+      candidates.push_back(r);
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  if (candidates.empty())
+    return out;
+  // Each candidate's triangles and vertices, with the free samples the co-cone
+  // triangles join to them, directly or through other free samples: the samples
+  // in its holes, which the advancing front needs to close them.
+  std::vector<int> slot(n, -1);
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    slot[candidates[i]] = static_cast<int>(i);
+  std::vector<std::vector<Triangle>> own(candidates.size());
+  for (const auto& t : triangles)
+    if (slot[root(t[0])] >= 0)
+      own[slot[root(t[0])]].push_back(t);
+  std::vector<std::vector<int>> region(candidates.size());
+  for (int v = 0; v < n; ++v)
+    if (used[v] && slot[root(v)] >= 0)
+      region[slot[root(v)]].push_back(v);
+  // Per vertex its free co-cone neighbours, in compressed rows.
+  std::vector<std::size_t> first(n + 1, 0);
+  for (const auto& t : cocone_triangles)
+    for (const int a : t.v)
+      for (const int b : t.v)
+        first[a + 1] += !used[b];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<int> free_neighbour(first[n]);
+  {
+    std::vector<std::size_t> next(first.begin(), first.end() - 1);
+    for (const auto& t : cocone_triangles)
+      for (const int a : t.v)
+        for (const int b : t.v)
+          if (!used[b])
+            free_neighbour[next[a]++] = b;
+  }
+  std::vector<int> reached(n, -1);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    // At most the square of the loops' edges, as the piece.
+    const double most = static_cast<double>(edges[candidates[i]]) *
+                        static_cast<double>(edges[candidates[i]]);
+    auto& vertices = region[i];
+    for (std::size_t k = 0;
+         k < vertices.size() && static_cast<double>(vertices.size()) <= most;
+         ++k)
+      for (std::size_t j = first[vertices[k]]; j < first[vertices[k] + 1]; ++j) {
+        const int b = free_neighbour[j];
+        if (reached[b] != static_cast<int>(i)) {
+          reached[b] = static_cast<int>(i);
+          vertices.push_back(b);
+        }
+      }
+    if (static_cast<double>(vertices.size()) > most)
+      vertices.clear();
+  }
+  const auto within_reach = [&](int a, int b) {
+    const double longest = reach * std::max(spacing[a], spacing[b]);
+    return (points[a] - points[b]).squaredNorm() <= longest * longest;
+  };
+  std::vector<std::uint8_t> replaced(n, 0), taken(n, 0);
+  std::vector<Triangle> added;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const int r = candidates[i];
+    std::sort(region[i].begin(), region[i].end());
+    const std::vector<Triangle> front = advancingFront(points, region[i], threads);
+    if (front.empty())
+      continue;
+    // Closed, one piece, the piece's genus: its Euler characteristic with its
+    // holes capped.
+    const auto holes =
+        static_cast<std::size_t>(std::count(roots.begin(), roots.end(), r));
+    const MeshTopology theirs = analyzeOn(region[i], front);
+    const MeshTopology ours = analyzeOn(region[i], own[i]);
+    bool ok = theirs.manifold() && theirs.components == 1 &&
+              theirs.boundary_edges == 0 &&
+              theirs.euler == ours.euler + static_cast<long>(holes);
+    for (const auto& t : front)
+      for (int c = 0; c < 3 && ok; ++c)
+        ok = within_reach(t[c], t[(c + 1) % 3]);
+    // A free sample closes one piece at most.
+    for (const int v : region[i])
+      ok = ok && !taken[v];
+    if (!ok)
+      continue;
+    for (const int v : region[i])
+      taken[v] = 1;
+    replaced[r] = 1;
+    added.insert(added.end(), front.begin(), front.end());
+    for (std::size_t l = 0; l < loops.size(); ++l)
+      if (roots[l] == r)
+        out.rims.push_back(loops[l]);
+    out.holes += holes;
+    out.triangles += front.size();
+  }
+  if (added.empty())
+    return out;
+  std::vector<Triangle> kept;
+  for (const auto& t : triangles)
+    if (!replaced[root(t[0])])
+      kept.push_back(t);
+  kept.insert(kept.end(), added.begin(), added.end());
+  triangles = std::move(kept);
+  incidences = EdgeIncidences(triangles, threads);
+  loops = boundaryLoops(incidences, points.size());
+  return out;
 }
 
 } // namespace cocone

@@ -280,6 +280,17 @@ reconstruct(Triangulation& dt,
                                      parameters.hole_reach,
                                      parameters.max_hole_edges,
                                      true_border));
+    // Pieces whose holes no patch closes, closed whole by the advancing front.
+    record(closePiecesWithAdvancingFront(dt.points,
+                                         spacing,
+                                         cells.triangles,
+                                         result.triangles,
+                                         incidences,
+                                         result.border_loops,
+                                         parameters.hole_reach,
+                                         parameters.max_hole_edges,
+                                         true_border,
+                                         threads));
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

@@ -178,5 +178,41 @@ advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
                    const std::vector<std::uint8_t>& region,
                    int threads = 1);
 
+/** \brief Close whole pieces of the mesh that the patches leave open: a piece
+ * whose loops are all undersampled holes is replaced by CGAL's advancing front over
+ * its vertices and the free samples next to them (sharing a co-cone triangle), where
+ * that is a single closed oriented manifold with the Euler characteristic of the
+ * piece with its holes capped (the genus the piece says) and every edge within the
+ * reach.
+ *
+ * The last resort after the patches: where the band round a hole is no disk (a
+ * hole winding round a tube a few samples across, its rim pinched by the walk's
+ * shards) no patch is bounded by the loop, but the advancing front over the whole
+ * piece, which grows each triangle from its neighbours', may close it. A piece with
+ * a true border is never replaced (the advancing front would not close it).
+ * Vertices the advancing front leaves out are left in no triangle.
+ * \param[in] points the vertex positions
+ * \param[in] spacing per vertex its local spacing (localSpacing())
+ * \param[in] cocone_triangles the co-cone triangles (VoronoiCells::triangles)
+ * \param[in,out] triangles the oriented manifold mesh
+ * \param[in,out] incidences the mesh's edge incidences, kept up to date
+ * \param[in,out] loops the mesh's border loops; the closed ones are taken out
+ * \param[in] reach the longest edge allowed, in local spacings
+ * \param[in] max_edges pieces with a loop longer than this are left open
+ * \param[in] true_border per vertex: on a true border; empty: none
+ * \param[in] threads threads for the repair of the advancing front's mesh
+ */
+HoleFilling
+closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<double>& spacing,
+                              const std::vector<CoconeTriangle>& cocone_triangles,
+                              std::vector<Triangle>& triangles,
+                              EdgeIncidences& incidences,
+                              std::vector<std::vector<int>>& loops,
+                              double reach,
+                              std::size_t max_edges,
+                              const std::vector<std::uint8_t>& true_border = {},
+                              int threads = 1);
+
 } // namespace cocone
 } // namespace pcl
