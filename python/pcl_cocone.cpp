@@ -467,6 +467,7 @@ toPython(cocone::Result& r,
   repair["filled"] = c.repair.filled;
   repair["ribbon"] = c.repair.ribbon;
   repair["speck"] = c.repair.speck;
+  repair["peeled"] = c.repair.peeled;
   py::dict counts;
   counts["candidates"] = c.candidates;
   counts["umbrella_failures"] = c.umbrella_failures;
@@ -572,6 +573,7 @@ eachCount(Counts& c, const F& f)
   f("repair.filled", c.repair.filled);
   f("repair.ribbon", c.repair.ribbon);
   f("repair.speck", c.repair.speck);
+  f("repair.peeled", c.repair.peeled);
   f("true_borders", c.true_borders);
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);

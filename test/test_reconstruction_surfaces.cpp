@@ -579,6 +579,43 @@ TEST(Walk, TwistedBandHasOneConflict)
   }
 }
 
+TEST(Repair, BorderSliversArePeeledOneLayer)
+{
+  // A fan of a square grid's corner vertex, and along the bottom border a sample
+  // just inside an edge between two border vertices: the triangle on that edge has
+  // an obtuse angle at the sample, so it is peeled and the border passes through
+  // the sample; a triangle whose apex is on the border is kept.
+  //   bottom row: 0 (0,0), 1 (2,0), 2 (4,0); sample 3 (1,0.3) between 0 and 1;
+  //   top row: 4 (0,2), 5 (2,2), 6 (4,2).
+  const std::vector<Eigen::Vector3d> points = {
+      {0, 0, 0}, {2, 0, 0}, {4, 0, 0}, {1, 0.3, 0}, {0, 2, 0}, {2, 2, 0}, {4, 2, 0}};
+  std::vector<pcl::cocone::Triangle> mesh = {
+      {0, 1, 3}, // on the border edge 0-1, obtuse at 3: peeled
+      {0, 3, 4},
+      {3, 1, 5},
+      {3, 5, 4},
+      {1, 2, 5}, // on the border edge 1-2, apex 5 on the border: kept
+      {2, 6, 5}};
+  pcl::cocone::EdgeIncidences incidences(mesh);
+  auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+  ASSERT_EQ(loops.size(), 1u);
+  const auto before = pcl::cocone::analyzeMesh(mesh, points.size());
+  EXPECT_EQ(pcl::cocone::peelBorderSlivers(points, mesh, incidences, loops), 1u);
+  EXPECT_EQ(mesh.size(), 5u);
+  EXPECT_EQ(std::count(mesh.begin(), mesh.end(), pcl::cocone::Triangle{0, 1, 3}), 0);
+  const auto after = pcl::cocone::analyzeMesh(mesh, points.size());
+  EXPECT_TRUE(after.manifold());
+  EXPECT_EQ(after.euler, before.euler);
+  EXPECT_EQ(after.vertices, before.vertices);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_NE(std::find(loops[0].begin(), loops[0].end(), 3), loops[0].end());
+  const pcl::cocone::EdgeIncidences fresh(mesh);
+  EXPECT_EQ(incidences.edges, fresh.edges);
+  EXPECT_EQ(loops, pcl::cocone::boundaryLoops(fresh, points.size()));
+  // The exposed triangles 0-3-4 and 3-1-5 have their apexes on the border.
+  EXPECT_EQ(pcl::cocone::peelBorderSlivers(points, mesh, incidences, loops), 0u);
+}
+
 TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)
 {
   // A band of 2n triangles with a half twist: no orientation agrees all round, so

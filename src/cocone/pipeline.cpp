@@ -291,6 +291,9 @@ reconstruct(Triangulation& dt,
                                          parameters.max_hole_edges,
                                          true_border,
                                          threads));
+    // The borders left through the samples on them.
+    counts.repair.peeled =
+        peelBorderSlivers(dt.points, result.triangles, incidences, result.border_loops);
   }
   // A canonical order: the same input gives the same mesh, whatever the walk order.
   for (auto& t : result.triangles)

@@ -33,12 +33,15 @@ struct RepairCounts {
   std::size_t ribbon = 0;
   /** Dropped with components of too few vertices (see dropSpecks()). */
   std::size_t speck = 0;
+  /** Peeled off true borders (see peelBorderSlivers()). */
+  std::size_t peeled = 0;
 
   /** Triangles dropped in all. */
   std::size_t
   dropped() const
   {
-    return nonmanifold_edge + nonmanifold_vertex + orientation + ribbon + speck;
+    return nonmanifold_edge + nonmanifold_vertex + orientation + ribbon + speck +
+           peeled;
   }
 };
 
@@ -124,6 +127,29 @@ dropSpecks(std::vector<Triangle>& triangles,
            std::size_t num_vertices,
            std::size_t min_vertices,
            EdgeIncidences* incidences = nullptr);
+
+/** \brief Peel the border triangles whose border edge skips a sample: the
+ * triangle's apex lies inside the edge's diametral ball (its angle there is obtuse,
+ * an exact predicate), so the apex is as near the border as the edge is, and the
+ * border passes through it instead.
+ *
+ * Where the samples along a border are uneven or noisy, the walk's border takes long
+ * edges between the outermost samples and leaves the samples just inside them as
+ * inner vertices: the mesh's border then misses parts of the sampled border (on
+ * random samples with noise, up to 16 % of it farther than 2.5 spacings from a
+ * border vertex). One pass: a triangle the peeling exposes is kept (peeling on eats
+ * into the surface), and so is a triangle whose apex is on a border or the apex of
+ * another peeled triangle (the mesh stays an oriented 2-manifold, no vertex is left
+ * without a triangle). The number of loops and the Euler characteristic stay.
+ * \param[in,out] incidences the edge incidences of \a triangles, kept up to date
+ * \param[in,out] loops the border loops (vertex ids, the mesh on their left), updated
+ * \return the number of triangles peeled
+ */
+std::size_t
+peelBorderSlivers(const std::vector<Eigen::Vector3d>& points,
+                  std::vector<Triangle>& triangles,
+                  EdgeIncidences& incidences,
+                  std::vector<std::vector<int>>& loops);
 
 } // namespace cocone
 } // namespace pcl
