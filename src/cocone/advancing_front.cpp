@@ -198,17 +198,17 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   std::vector<std::size_t> size(n, 0);
   for (int v = 0; v < n; ++v)
     size[root(v)] += used[v];
-  // A candidate: a piece whose loops are all undersampled holes, together about
-  // as large as the piece (its vertices at most the square of their edges). A
-  // piece much larger than its holes closes them locally (the patches) or not at
-  // all; this also bounds the advancing front's cost.
+  // A candidate: a piece whose loops are all undersampled holes, the longest about
+  // as large as the piece (its vertices at most the square of its edges). A piece
+  // much larger than its holes, however many, closes them locally (the patches) or
+  // not at all; this also bounds the advancing front's cost.
   std::vector<int> roots;
-  std::vector<std::size_t> edges(n, 0);
+  std::vector<std::size_t> longest(n, 0);
   std::vector<std::uint8_t> rejected(n, 0);
   for (const auto& loop : loops) {
     const int r = root(loop[0]);
     roots.push_back(r);
-    edges[r] += loop.size();
+    longest[r] = std::max(longest[r], loop.size());
     rejected[r] |=
         loop.size() > max_edges ||
         (!true_border.empty() &&
@@ -218,7 +218,7 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   for (const int r : roots)
     if (!rejected[r] &&
         static_cast<double>(size[r]) <=
-            static_cast<double>(edges[r]) * static_cast<double>(edges[r]))
+            static_cast<double>(longest[r]) * static_cast<double>(longest[r]))
       candidates.push_back(r);
   std::sort(candidates.begin(), candidates.end());
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
@@ -256,9 +256,9 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   }
   std::vector<int> reached(n, -1);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    // At most the square of the loops' edges, as the piece.
-    const double most = static_cast<double>(edges[candidates[i]]) *
-                        static_cast<double>(edges[candidates[i]]);
+    // At most the square of the longest loop's edges, as the piece.
+    const double most = static_cast<double>(longest[candidates[i]]) *
+                        static_cast<double>(longest[candidates[i]]);
     auto& vertices = region[i];
     for (std::size_t k = 0;
          k < vertices.size() && static_cast<double>(vertices.size()) <= most;

@@ -179,18 +179,22 @@ advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
                    int threads = 1);
 
 /** \brief Close whole pieces of the mesh that the patches leave open: a piece
- * whose loops are all undersampled holes is replaced by CGAL's advancing front over
- * its vertices and the free samples next to them (sharing a co-cone triangle), where
+ * whose loops are all undersampled holes, the longest about as large as the piece
+ * (the piece's vertices at most the square of its edges), is replaced by CGAL's
+ * advancing front over its vertices and the free samples the co-cone triangles join
+ * to them (directly or through other free samples: the samples in its holes), where
  * that is a single closed oriented manifold with the Euler characteristic of the
  * piece with its holes capped (the genus the piece says) and every edge within the
- * reach.
+ * reach. A free sample closes one piece at most.
  *
  * The last resort after the patches: where the band round a hole is no disk (a
  * hole winding round a tube a few samples across, its rim pinched by the walk's
  * shards) no patch is bounded by the loop, but the advancing front over the whole
- * piece, which grows each triangle from its neighbours', may close it. A piece with
- * a true border is never replaced (the advancing front would not close it).
- * Vertices the advancing front leaves out are left in no triangle.
+ * piece, which grows each triangle from its neighbours', may close it. A piece much
+ * larger than its holes, however many, is left to the patches (which also bounds
+ * the cost to the square of \a max_edges points); a piece with a true border is
+ * never replaced (the advancing front would not close it). Vertices the advancing
+ * front leaves out are left in no triangle.
  * \param[in] points the vertex positions
  * \param[in] spacing per vertex its local spacing (localSpacing())
  * \param[in] cocone_triangles the co-cone triangles (VoronoiCells::triangles)
