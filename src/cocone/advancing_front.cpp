@@ -13,6 +13,8 @@
 #include <CGAL/Advancing_front_surface_reconstruction.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "points.h"
+
 #include <algorithm>
 #include <array>
 #include <iterator>
@@ -273,10 +275,6 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     if (static_cast<double>(vertices.size()) > most)
       vertices.clear();
   }
-  const auto within_reach = [&](int a, int b) {
-    const double longest = reach * std::max(spacing[a], spacing[b]);
-    return (points[a] - points[b]).squaredNorm() <= longest * longest;
-  };
   std::vector<std::uint8_t> replaced(n, 0), taken(n, 0);
   std::vector<Triangle> added;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
@@ -296,7 +294,7 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
               theirs.euler == ours.euler + static_cast<long>(holes);
     for (const auto& t : front)
       for (int c = 0; c < 3 && ok; ++c)
-        ok = within_reach(t[c], t[(c + 1) % 3]);
+        ok = detail::withinReach(points, spacing, reach, t[c], t[(c + 1) % 3]);
     // A free sample closes one piece at most.
     for (const int v : region[i])
       ok = ok && !taken[v];

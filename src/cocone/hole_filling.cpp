@@ -15,6 +15,7 @@
 #include <Eigen/Dense>
 
 #include "loop_plane.h"
+#include "points.h"
 
 #include <algorithm>
 #include <array>
@@ -59,18 +60,7 @@ edgeKey(int a, int b)
   return {std::min(a, b), std::max(a, b)};
 }
 
-/** Whether edge ab is at most \a reach times the larger local spacing of its ends
- * long: as short as the triangles of the sampling there. */
-bool
-withinReach(const std::vector<Eigen::Vector3d>& points,
-            const std::vector<double>& spacing,
-            double reach,
-            int a,
-            int b)
-{
-  const double longest = reach * std::max(spacing[a], spacing[b]);
-  return (points[a] - points[b]).squaredNorm() <= longest * longest;
-}
+using detail::withinReach;
 
 /** Whether a vertex of \a loop is on a true border (classifyBorderLoops()). */
 bool

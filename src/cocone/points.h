@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace pcl {
 namespace cocone {
@@ -22,6 +23,19 @@ inline bool
 isFinite(const Eigen::Vector3d& p)
 {
   return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
+}
+
+/** Whether edge ab is at most \a reach times the larger local spacing of its ends
+ * long: as short as the triangles of the sampling there. */
+inline bool
+withinReach(const std::vector<Eigen::Vector3d>& points,
+            const std::vector<double>& spacing,
+            double reach,
+            int a,
+            int b)
+{
+  const double longest = reach * std::max(spacing[a], spacing[b]);
+  return (points[a] - points[b]).squaredNorm() <= longest * longest;
 }
 
 /** Lexicographic order of coordinates: the canonical order for tie-breaks. */
