@@ -183,69 +183,70 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   if (loops.empty())
     return out;
   const auto n = static_cast<int>(points.size());
-  // The pieces: one fan per vertex, so triangles sharing a vertex share an edge.
-  std::vector<int> piece(n);
-  std::iota(piece.begin(), piece.end(), 0);
-  const auto root = [&](int v) {
-    while (piece[v] != v)
-      v = piece[v] = piece[piece[v]];
-    return v;
-  };
-  std::vector<std::uint8_t> used(n, 0);
-  for (const auto& t : triangles)
-    for (int c = 0; c < 3; ++c) {
-      used[t[c]] = 1;
-      piece[root(t[c])] = root(t[0]);
-    }
-  std::vector<std::size_t> size(n, 0);
-  for (int v = 0; v < n; ++v)
-    size[root(v)] += used[v];
+  // The pieces (components through shared edges) and each one's vertices and Euler
+  // characteristic; a vertex is in one piece at most (one fan each).
+  std::size_t pieces = 0;
+  const std::vector<int> piece_of_triangle =
+      triangleComponents(incidences, triangles.size(), &pieces);
+  std::vector<int> piece(n, -1);
+  std::vector<long> euler(pieces, 0);
+  std::vector<std::size_t> size(pieces, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const int p = piece_of_triangle[t];
+    euler[p] += 1;
+    for (const int v : triangles[t])
+      if (piece[v] < 0) {
+        piece[v] = p;
+        ++size[p];
+      }
+  }
+  for (std::size_t e = 0; e < incidences.edges.size(); ++e)
+    euler[piece[incidences.edges[e][0]]] -= 1;
+  for (std::size_t p = 0; p < pieces; ++p)
+    euler[p] += static_cast<long>(size[p]);
   // A candidate: a piece whose loops are all undersampled holes, the longest about
   // as large as the piece (its vertices at most the square of its edges). A piece
   // much larger than its holes, however many, closes them locally (the patches) or
   // not at all; this also bounds the advancing front's cost.
-  std::vector<int> roots;
-  std::vector<std::size_t> longest(n, 0);
-  std::vector<std::uint8_t> rejected(n, 0);
+  std::vector<int> loop_piece;
+  std::vector<std::size_t> longest(pieces, 0), holes(pieces, 0);
+  std::vector<std::uint8_t> rejected(pieces, 0);
   for (const auto& loop : loops) {
-    const int r = root(loop[0]);
-    roots.push_back(r);
-    longest[r] = std::max(longest[r], loop.size());
-    rejected[r] |=
+    const int p = piece[loop[0]];
+    loop_piece.push_back(p);
+    longest[p] = std::max(longest[p], loop.size());
+    ++holes[p];
+    rejected[p] |=
         loop.size() > max_edges ||
         (!true_border.empty() &&
          std::any_of(loop.begin(), loop.end(), [&](int v) { return true_border[v]; }));
   }
+  const auto square = [](std::size_t k) {
+    return static_cast<double>(k) * static_cast<double>(k);
+  };
   std::vector<int> candidates;
-  for (const int r : roots)
-    if (!rejected[r] &&
-        static_cast<double>(size[r]) <=
-            static_cast<double>(longest[r]) * static_cast<double>(longest[r]))
-      candidates.push_back(r);
-  std::sort(candidates.begin(), candidates.end());
-  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  for (std::size_t p = 0; p < pieces; ++p)
+    if (holes[p] > 0 && !rejected[p] &&
+        static_cast<double>(size[p]) <= square(longest[p]))
+      candidates.push_back(static_cast<int>(p));
   if (candidates.empty())
     return out;
-  // Each candidate's triangles and vertices, with the free samples the co-cone
-  // triangles join to them, directly or through other free samples: the samples
-  // in its holes, which the advancing front needs to close them.
-  std::vector<int> slot(n, -1);
+  // Each candidate's vertices, with the free samples the co-cone triangles join to
+  // them, directly or through other free samples: the samples in its holes, which
+  // the advancing front needs to close them.
+  std::vector<int> slot(pieces, -1);
   for (std::size_t i = 0; i < candidates.size(); ++i)
     slot[candidates[i]] = static_cast<int>(i);
-  std::vector<std::vector<Triangle>> own(candidates.size());
-  for (const auto& t : triangles)
-    if (slot[root(t[0])] >= 0)
-      own[slot[root(t[0])]].push_back(t);
   std::vector<std::vector<int>> region(candidates.size());
   for (int v = 0; v < n; ++v)
-    if (used[v] && slot[root(v)] >= 0)
-      region[slot[root(v)]].push_back(v);
+    if (piece[v] >= 0 && slot[piece[v]] >= 0)
+      region[slot[piece[v]]].push_back(v);
   // Per vertex its free co-cone neighbours, in compressed rows.
   std::vector<std::size_t> first(n + 1, 0);
   for (const auto& t : cocone_triangles)
     for (const int a : t.v)
       for (const int b : t.v)
-        first[a + 1] += !used[b];
+        first[a + 1] += piece[b] < 0;
   std::partial_sum(first.begin(), first.end(), first.begin());
   std::vector<int> free_neighbour(first[n]);
   {
@@ -253,14 +254,13 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     for (const auto& t : cocone_triangles)
       for (const int a : t.v)
         for (const int b : t.v)
-          if (!used[b])
+          if (piece[b] < 0)
             free_neighbour[next[a]++] = b;
   }
   std::vector<int> reached(n, -1);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     // At most the square of the longest loop's edges, as the piece.
-    const double most = static_cast<double>(longest[candidates[i]]) *
-                        static_cast<double>(longest[candidates[i]]);
+    const double most = square(longest[candidates[i]]);
     auto& vertices = region[i];
     for (std::size_t k = 0;
          k < vertices.size() && static_cast<double>(vertices.size()) <= most;
@@ -275,23 +275,20 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     if (static_cast<double>(vertices.size()) > most)
       vertices.clear();
   }
-  std::vector<std::uint8_t> replaced(n, 0), taken(n, 0);
+  std::vector<std::uint8_t> replaced(pieces, 0), taken(n, 0);
   std::vector<Triangle> added;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    const int r = candidates[i];
+    const int p = candidates[i];
     std::sort(region[i].begin(), region[i].end());
     const std::vector<Triangle> front = advancingFront(points, region[i], threads);
     if (front.empty())
       continue;
     // Closed, one piece, the piece's genus: its Euler characteristic with its
     // holes capped.
-    const auto holes =
-        static_cast<std::size_t>(std::count(roots.begin(), roots.end(), r));
     const MeshTopology theirs = analyzeOn(region[i], front);
-    const MeshTopology ours = analyzeOn(region[i], own[i]);
     bool ok = theirs.manifold() && theirs.components == 1 &&
               theirs.boundary_edges == 0 &&
-              theirs.euler == ours.euler + static_cast<long>(holes);
+              theirs.euler == euler[p] + static_cast<long>(holes[p]);
     for (const auto& t : front)
       for (int c = 0; c < 3 && ok; ++c)
         ok = detail::withinReach(points, spacing, reach, t[c], t[(c + 1) % 3]);
@@ -302,23 +299,24 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
       continue;
     for (const int v : region[i])
       taken[v] = 1;
-    replaced[r] = 1;
+    replaced[p] = 1;
     added.insert(added.end(), front.begin(), front.end());
     for (std::size_t l = 0; l < loops.size(); ++l)
-      if (roots[l] == r)
+      if (loop_piece[l] == p)
         out.rims.push_back(loops[l]);
-    out.holes += holes;
+    out.holes += holes[p];
     out.triangles += front.size();
   }
   if (added.empty())
     return out;
-  std::vector<Triangle> kept;
-  for (const auto& t : triangles)
-    if (!replaced[root(t[0])])
-      kept.push_back(t);
-  kept.insert(kept.end(), added.begin(), added.end());
-  triangles = std::move(kept);
-  incidences = EdgeIncidences(triangles, threads);
+  // Out with the pieces replaced, in with the advancing front's triangles.
+  std::vector<std::uint8_t> drop(triangles.size(), 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    drop[t] = replaced[piece_of_triangle[t]];
+  removeTriangles(triangles, drop, &incidences);
+  const std::size_t kept = triangles.size();
+  triangles.insert(triangles.end(), added.begin(), added.end());
+  incidences.add(triangles, kept);
   loops = boundaryLoops(incidences, points.size());
   return out;
 }

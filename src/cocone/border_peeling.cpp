@@ -37,10 +37,7 @@ peelBorderSlivers(const std::vector<Eigen::Vector3d>& points,
       if (e < 0 || incidences.count(e) != 1)
         continue;
       const int t = incidences.triangle[incidences.first[e]];
-      const Triangle& tri = triangles[t];
-      const int x = tri[0] != a && tri[0] != b   ? tri[0]
-                    : tri[1] != a && tri[1] != b ? tri[1]
-                                                 : tri[2];
+      const int x = thirdCorner(triangles[t], a, b);
       if (taken[x] || CGAL::angle(point(a), point(x), point(b)) != CGAL::OBTUSE)
         continue;
       taken[x] = 1;
@@ -49,12 +46,7 @@ peelBorderSlivers(const std::vector<Eigen::Vector3d>& points,
     }
   if (count == 0)
     return 0;
-  std::size_t kept = 0;
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    if (!peeled[t])
-      triangles[kept++] = triangles[t];
-  triangles.resize(kept);
-  incidences.remove(peeled);
+  removeTriangles(triangles, peeled, &incidences);
   loops = boundaryLoops(incidences, points.size());
   return count;
 }

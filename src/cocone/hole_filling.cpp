@@ -139,10 +139,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       // The third corner of the mesh's triangle at the loop's edge ab.
       const auto e = incidences.find(a, b);
       const Triangle& t = triangles[incidences.triangle[incidences.first[e]]];
-      const int c = t[0] != a && t[0] != b   ? t[0]
-                    : t[1] != a && t[1] != b ? t[1]
-                                             : t[2];
-      third.push_back(toCgal(points[c]));
+      third.push_back(toCgal(points[thirdCorner(t, a, b)]));
     }
     found.clear();
     CGAL::Polygon_mesh_processing::triangulate_hole_polyline(

@@ -28,24 +28,6 @@ unitNormal(const std::vector<Eigen::Vector3d>& P, const Triangle& t)
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
 }
 
-/** Remove the triangles marked in drop, from \a inc too if given; returns how
- * many. */
-std::size_t
-compact(std::vector<Triangle>& triangles,
-        const std::vector<std::uint8_t>& drop,
-        EdgeIncidences* inc = nullptr)
-{
-  std::size_t j = 0;
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    if (!drop[t])
-      triangles[j++] = triangles[t];
-  const std::size_t dropped = triangles.size() - j;
-  triangles.resize(j);
-  if (inc && dropped)
-    inc->remove(drop);
-  return dropped;
-}
-
 /** The edge incidences of \a triangles: \a known if given and grouped, else grouped
  * into \a storage. */
 const EdgeIncidences&
@@ -91,7 +73,7 @@ resolveEdges(const std::vector<Eigen::Vector3d>& P,
         any = true;
       }
   }
-  return any ? compact(triangles, drop, &inc) : 0;
+  return any ? removeTriangles(triangles, drop, &inc) : 0;
 }
 
 /** At every vertex with several fans keep the largest; with \a only, at the vertices
@@ -153,7 +135,7 @@ resolveVertices(std::vector<Triangle>& triangles,
         touched[w] = 1;
     }
   }
-  return compact(triangles, drop, &inc);
+  return removeTriangles(triangles, drop, &inc);
 }
 
 /** Orient each component consistently and outward; returns triangles that could not
@@ -342,10 +324,26 @@ orient(const std::vector<Eigen::Vector3d>& P,
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)
   for (std::ptrdiff_t i = 0; i < incidences; ++i)
     inc.forward[i] ^= turned_over[inc.triangle[i]];
-  return compact(triangles, drop, &inc);
+  return removeTriangles(triangles, drop, &inc);
 }
 
 } // namespace
+
+std::size_t
+removeTriangles(std::vector<Triangle>& triangles,
+                const std::vector<std::uint8_t>& drop,
+                EdgeIncidences* inc)
+{
+  std::size_t j = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    if (!drop[t])
+      triangles[j++] = triangles[t];
+  const std::size_t dropped = triangles.size() - j;
+  triangles.resize(j);
+  if (inc && dropped)
+    inc->remove(drop);
+  return dropped;
+}
 
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
@@ -517,7 +515,7 @@ dropComponents(std::vector<Triangle>& triangles,
     drop[t] = marked[component[t]];
   if (incidences && &inc == &grouped)
     *incidences = std::move(grouped);
-  return compact(triangles, drop, incidences);
+  return removeTriangles(triangles, drop, incidences);
 }
 
 } // namespace

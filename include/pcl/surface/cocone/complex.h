@@ -16,6 +16,13 @@ namespace cocone {
 
 using Triangle = std::array<int, 3>;
 
+/** The corner of \a t that is neither \a a nor \a b (two of its corners). */
+inline int
+thirdCorner(const Triangle& t, int a, int b)
+{
+  return t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
+}
+
 /** \brief A triangle complex with its edges and incidences, as flat arrays.
  *
  * Stages 5-7 (umbrella check, pruning, walk) work on the candidate triangles

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -127,6 +128,15 @@ dropSpecks(std::vector<Triangle>& triangles,
            std::size_t num_vertices,
            std::size_t min_vertices,
            EdgeIncidences* incidences = nullptr);
+
+/** \brief Take the triangles marked in \a drop out of \a triangles (the others keep
+ * their order) and, if given, out of their edge incidences \a inc.
+ * \return the number taken out
+ */
+std::size_t
+removeTriangles(std::vector<Triangle>& triangles,
+                const std::vector<std::uint8_t>& drop,
+                EdgeIncidences* inc = nullptr);
 
 /** \brief Peel the border triangles whose border edge skips a sample: the
  * triangle's apex lies inside the edge's diametral ball (its angle there is obtuse,
