@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 
+#include "least_perimeter.h"
 #include "loop_plane.h"
 #include "points.h"
 
@@ -21,6 +22,7 @@
 #include <array>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 #include <utility>
@@ -41,6 +43,17 @@ struct LoopTriangle {
 /** Loops of at most this many edges whose Delaunay patch is not plausible are
  * searched again over all triangles of their vertices (cubic in the edges). */
 constexpr std::size_t CUBIC_SEARCH_EDGES = 40;
+
+/** Loops of at most this many edges are tried by fillHolesWithLeastPerimeter() (its
+ * search is cubic in the edges; the longest slit measured had 52). */
+constexpr std::size_t LEAST_PERIMETER_EDGES = 128;
+
+/** The largest angle between the normals of two triangles at an edge of a least
+ * perimeter patch, patch or mesh: beyond it the patch folds back over itself or the
+ * mesh. cos 150 degrees: round the rim of a plate thinner than the spacing the
+ * surface turns a half turn within a triangle or two (120 degrees left 4 of the 8
+ * slits of a 10,000-point plate open, at 121). */
+constexpr double FOLD_COSINE = -0.866;
 
 /** A patch from another mesh may hold at most this many triangles per loop edge:
  * a disk of a loop's k edges with i inner vertices has k + 2i - 2 triangles. */
@@ -929,6 +942,70 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
     for (const int q : inner)
       used[q] = 1;
     return !patch.empty();
+  };
+  return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
+}
+
+HoleFilling
+fillHolesWithLeastPerimeter(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<double>& spacing,
+                            std::vector<Triangle>& triangles,
+                            EdgeIncidences& incidences,
+                            std::vector<std::vector<int>>& loops,
+                            double reach,
+                            std::size_t max_edges,
+                            const std::vector<std::uint8_t>& true_border)
+{
+  std::vector<std::uint8_t> new_edge_ok;
+  std::vector<Triangle> found;
+  std::map<std::array<int, 2>, Eigen::Vector3d> normal_at;
+  const auto normal = [&](const Triangle& t) {
+    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+  };
+  const auto patch_of = [&](const std::vector<int>& loop,
+                            std::vector<Triangle>& patch) {
+    const std::size_t k = loop.size();
+    if (k > LEAST_PERIMETER_EDGES)
+      return false;
+    // The hole runs against the loop: its triangles in the hole's order face as the
+    // mesh. A new edge must be within the reach and new to the mesh.
+    const std::vector<int> hole(loop.rbegin(), loop.rend());
+    new_edge_ok.assign(k * k, 0);
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 1; j < k; ++j)
+        new_edge_ok[i * k + j] =
+            j == i + 1 || (i == 0 && j == k - 1) ||
+            (withinReach(points, spacing, reach, hole[i], hole[j]) &&
+             incidences.find(hole[i], hole[j]) < 0);
+    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
+      return new_edge_ok[i * k + m] && new_edge_ok[m * k + j] && new_edge_ok[i * k + j];
+    };
+    found.clear();
+    if (!detail::leastPerimeterTriangulation(points, hole, valid, found))
+      return false;
+    // No fold: at every edge the patch's triangles and the mesh's beside the loop
+    // face within FOLD_COSINE of each other.
+    normal_at.clear();
+    const auto agrees = [&](int a, int b, const Eigen::Vector3d& n) {
+      const auto [it, first] = normal_at.emplace(edgeKey(a, b), n);
+      return first || n.dot(it->second) > FOLD_COSINE * n.norm() * it->second.norm();
+    };
+    for (std::size_t i = 0; i < k; ++i) {
+      const int a = loop[i], b = loop[(i + 1) % k];
+      const auto e = incidences.find(a, b);
+      normal_at.emplace(edgeKey(a, b),
+                        normal(triangles[incidences.triangle[incidences.first[e]]]));
+    }
+    for (const Triangle& t : found) {
+      const Eigen::Vector3d n = normal(t);
+      if (!(n.squaredNorm() > 0.0))
+        return false;
+      for (int c = 0; c < 3; ++c)
+        if (!agrees(t[c], t[(c + 1) % 3], n))
+          return false;
+    }
+    patch.insert(patch.end(), found.begin(), found.end());
+    return true;
   };
   return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
 }

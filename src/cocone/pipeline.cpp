@@ -291,6 +291,15 @@ reconstruct(Triangulation& dt,
                                          parameters.max_hole_edges,
                                          true_border,
                                          threads));
+    // Long narrow holes left, closed by the strip across them.
+    record(fillHolesWithLeastPerimeter(dt.points,
+                                       spacing,
+                                       result.triangles,
+                                       incidences,
+                                       result.border_loops,
+                                       parameters.hole_reach,
+                                       parameters.max_hole_edges,
+                                       true_border));
     // The borders left through the samples on them.
     counts.repair.peeled =
         peelBorderSlivers(dt.points, result.triangles, incidences, result.border_loops);

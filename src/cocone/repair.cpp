@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "least_perimeter.h"
 #include "parallel.h"
 
 #include <algorithm>
@@ -421,10 +422,6 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
   std::sort(starts.begin(), starts.end());
   std::vector<std::uint8_t> done(num_vertices, 0);
   std::vector<int> loop;
-  // Per hole: the dynamic programme's tables and the ranges still to triangulate.
-  std::vector<double> cost;
-  std::vector<int> split;
-  std::vector<std::array<std::size_t, 2>> stack;
   std::size_t added = 0;
   for (const int x : starts) {
     if (done[x])
@@ -438,8 +435,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
     if (k < 3 || k > max_edges || hole_next[loop.back()] != x)
       continue;
     // The triangulation of the hole's polygon by allowed triangles with the least
-    // total perimeter (dynamic programming over the polygon); no new edge may
-    // already be in the mesh.
+    // total perimeter; no new edge may already be in the mesh.
     const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
       Triangle key{loop[i], loop[m], loop[j]};
       std::sort(key.begin(), key.end());
@@ -452,41 +448,9 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
              !(diagonal(m, j) && edge_id(loop[m], loop[j]) >= 0) &&
              !(diagonal(i, j) && edge_id(loop[i], loop[j]) >= 0);
     };
-    const double inf = std::numeric_limits<double>::infinity();
-    cost.assign(k * k, inf);
-    split.assign(k * k, -1);
-    for (std::size_t i = 0; i + 1 < k; ++i)
-      cost[i * k + i + 1] = 0.0;
-    for (std::size_t len = 2; len < k; ++len)
-      for (std::size_t i = 0; i + len < k; ++i) {
-        const std::size_t j = i + len;
-        for (std::size_t m = i + 1; m < j; ++m) {
-          const double c = cost[i * k + m] + cost[m * k + j];
-          if (!(c < inf) || !valid(i, m, j))
-            continue;
-          const Eigen::Vector3d &a = points[loop[i]], &b = points[loop[m]],
-                                &d = points[loop[j]];
-          const double w = c + (a - b).norm() + (b - d).norm() + (d - a).norm();
-          if (w < cost[i * k + j]) {
-            cost[i * k + j] = w;
-            split[i * k + j] = static_cast<int>(m);
-          }
-        }
-      }
-    if (!(cost[k - 1] < inf))
-      continue;
-    stack.assign(1, {0, k - 1});
-    while (!stack.empty()) {
-      const auto [i, j] = stack.back();
-      stack.pop_back();
-      if (j - i < 2)
-        continue;
-      const std::size_t m = split[i * k + j];
-      triangles.push_back({loop[i], loop[m], loop[j]});
-      ++added;
-      stack.push_back({i, m});
-      stack.push_back({m, j});
-    }
+    const std::size_t size = triangles.size();
+    if (detail::leastPerimeterTriangulation(points, loop, valid, triangles))
+      added += triangles.size() - size;
   }
   if (incidences && &inc == &grouped)
     *incidences = std::move(grouped);

@@ -218,5 +218,39 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
                               const std::vector<std::uint8_t>& true_border = {},
                               int threads = 1);
 
+/** \brief Close the loops every other patch left open with the triangulation of the
+ * loop's polygon of least total edge length among those whose new edges are within
+ * the reach and new to the mesh, if it does not fold (at each of its edges the two
+ * triangles, the patch's or the mesh's beside the loop, face within 150 degrees of
+ * each other). No new vertex; the patch faces as the mesh.
+ *
+ * The last patch: CGAL's triangulate_hole_polyline() (fillUndersampledHoles())
+ * weighs the dihedral angles first (Liepa), which across a long narrow hole, such as
+ * a slit along the rim of a plate thinner than the spacing (its two sheets come
+ * within a spacing there, and the walk leaves the rim open in stretches), prefers a
+ * fan of long edges from one end to the short strip across it. Weighing length
+ * finds the strip. Assumes, as the other patches do, that a true hole is wider
+ * than the reach.
+ * \param[in] points the vertex positions
+ * \param[in] spacing per vertex its local spacing (localSpacing())
+ * \param[in,out] triangles the oriented manifold mesh; the patches are appended
+ * \param[in,out] incidences the mesh's edge incidences, kept up to date
+ * \param[in,out] loops the mesh's border loops; the closed ones are taken out
+ * \param[in] reach the longest new edge allowed, in local spacings
+ * \param[in] max_edges loops longer than this (or than 128 edges: the search is
+ *            cubic in the edges) are left open
+ * \param[in] true_border per vertex: on a true border, whose loop stays open;
+ *            empty: none
+ */
+HoleFilling
+fillHolesWithLeastPerimeter(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<double>& spacing,
+                            std::vector<Triangle>& triangles,
+                            EdgeIncidences& incidences,
+                            std::vector<std::vector<int>>& loops,
+                            double reach,
+                            std::size_t max_edges,
+                            const std::vector<std::uint8_t>& true_border = {});
+
 } // namespace cocone
 } // namespace pcl
