@@ -294,7 +294,12 @@ public:
    * triangle, then get the original Co-cone's triangles there where those make a
    * disk bounded by the loop or a closed surface, with edges as short (a part
    * sampled too coarsely for the flatness test, such as a thin tube, which it flags
-   * all over). No new vertex; the mesh stays an oriented manifold.
+   * all over). What those leave the advancing front's triangles may close (the
+   * density changing faster than the co-cones follow), then the samples inside a
+   * hole that no mesh used, then the advancing front over a whole piece whose hole
+   * winds round it, and last the patch of least total edge length within the same
+   * reach (a long narrow hole, such as a slit along the rim of a plate thinner than
+   * the spacing). No new vertex; the mesh stays an oriented manifold.
    * A loop that is wider than setMaxHoleWidth() of its rim's triangles with no
    * sample in it is a true border and is left as it is. getBoundaryPointIndices() is
    * not changed by it (the paper's output); getBoundaryLoops() lists the loops left.
