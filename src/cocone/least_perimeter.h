@@ -38,6 +38,11 @@ leastPerimeterTriangulation(const std::vector<Eigen::Vector3d>& points,
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> cost(k * k, inf);
   std::vector<int> split(k * k, -1);
+  // The loop's pairwise distances, once (the search reads each k times).
+  std::vector<double> length(k * k, 0.0);
+  for (std::size_t i = 0; i < k; ++i)
+    for (std::size_t j = i + 1; j < k; ++j)
+      length[i * k + j] = (points[loop[i]] - points[loop[j]]).norm();
   for (std::size_t i = 0; i + 1 < k; ++i)
     cost[i * k + i + 1] = 0.0;
   for (std::size_t len = 2; len < k; ++len)
@@ -47,9 +52,7 @@ leastPerimeterTriangulation(const std::vector<Eigen::Vector3d>& points,
         const double c = cost[i * k + m] + cost[m * k + j];
         if (!(c < inf) || !valid(i, m, j))
           continue;
-        const Eigen::Vector3d &a = points[loop[i]], &b = points[loop[m]],
-                              &d = points[loop[j]];
-        const double w = c + (a - b).norm() + (b - d).norm() + (d - a).norm();
+        const double w = c + length[i * k + m] + length[m * k + j] + length[i * k + j];
         if (w < cost[i * k + j]) {
           cost[i * k + j] = w;
           split[i * k + j] = static_cast<int>(m);
