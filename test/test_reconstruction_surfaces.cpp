@@ -1065,8 +1065,16 @@ TEST(HoleFilling, SlitIsClosedByTheStripAcrossIt)
     std::vector<std::uint8_t> true_border;
     if (on_true_border)
       true_border.assign(points.size(), 1);
-    const auto closed = pcl::cocone::fillHolesWithLeastPerimeter(
-        points, spacing, mesh, incidences, loops, 2.75, max_edges, true_border);
+    const auto closed =
+        pcl::cocone::fillUndersampledHoles(points,
+                                           spacing,
+                                           mesh,
+                                           incidences,
+                                           loops,
+                                           2.75,
+                                           max_edges,
+                                           true_border,
+                                           pcl::cocone::HoleWeight::LEAST_PERIMETER);
     const pcl::cocone::EdgeIncidences fresh(mesh);
     EXPECT_EQ(incidences.edges, fresh.edges);
     EXPECT_EQ(loops, pcl::cocone::boundaryLoops(fresh, points.size()));

@@ -22,7 +22,6 @@
 #include <array>
 #include <iterator>
 #include <limits>
-#include <map>
 #include <numeric>
 #include <set>
 #include <utility>
@@ -44,7 +43,7 @@ struct LoopTriangle {
  * searched again over all triangles of their vertices (cubic in the edges). */
 constexpr std::size_t CUBIC_SEARCH_EDGES = 40;
 
-/** Loops of at most this many edges are tried by fillHolesWithLeastPerimeter() (its
+/** Loops of at most this many edges are tried with HoleWeight::LEAST_PERIMETER (the
  * search is cubic in the edges; the longest slit measured had 52). */
 constexpr std::size_t LEAST_PERIMETER_EDGES = 128;
 
@@ -134,25 +133,35 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       std::vector<std::vector<int>>& loops,
                       double reach,
                       std::size_t max_edges,
-                      const std::vector<std::uint8_t>& true_border)
+                      const std::vector<std::uint8_t>& true_border,
+                      HoleWeight weight)
 {
+  std::vector<int> hole;
+  // Plausible: an edge of the hole, or a new edge within the reach and not in the
+  // mesh yet (i, j positions in the hole).
+  const auto plausible = [&](std::size_t i, std::size_t j) {
+    if (j < i)
+      std::swap(i, j);
+    if (j == i + 1 || (i == 0 && j + 1 == hole.size()))
+      return true;
+    return withinReach(points, spacing, reach, hole[i], hole[j]) &&
+           incidences.find(hole[i], hole[j]) < 0;
+  };
+  // The mesh's triangle at the loop's edge ab.
+  const auto beside = [&](int a, int b) -> const Triangle& {
+    return triangles[incidences.triangle[incidences.first[incidences.find(a, b)]]];
+  };
+
   std::vector<Kernel::Point_3> polyline, third;
   std::vector<LoopTriangle> found;
-  const auto patch_of = [&](const std::vector<int>& loop,
-                            std::vector<Triangle>& patch) {
-    const std::size_t k = loop.size();
-    // The hole runs against the loop, which has the mesh on its left: a triangle
-    // of the hole's polygon with its corners in the hole's order faces as the mesh.
-    const std::vector<int> hole(loop.rbegin(), loop.rend());
+  const auto dihedral_patch = [&](std::vector<Triangle>& patch) {
+    const std::size_t k = hole.size();
     polyline.clear();
     third.clear();
     for (std::size_t i = 0; i < k; ++i) {
       const int a = hole[i], b = hole[(i + 1) % k];
       polyline.push_back(toCgal(points[a]));
-      // The third corner of the mesh's triangle at the loop's edge ab.
-      const auto e = incidences.find(a, b);
-      const Triangle& t = triangles[incidences.triangle[incidences.first[e]]];
-      third.push_back(toCgal(points[thirdCorner(t, a, b)]));
+      third.push_back(toCgal(points[thirdCorner(beside(a, b), a, b)]));
     }
     found.clear();
     CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
@@ -161,15 +170,6 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
         std::back_inserter(found),
         CGAL::parameters::use_delaunay_triangulation(true).do_not_use_cubic_algorithm(
             true));
-    // Plausible: every new edge short and not in the mesh yet.
-    const auto plausible = [&](int i, int j) {
-      if (j < i)
-        std::swap(i, j);
-      if (j == i + 1 || (i == 0 && j == static_cast<int>(k) - 1))
-        return true; // an edge of the loop
-      const int a = hole[i], b = hole[j];
-      return withinReach(points, spacing, reach, a, b) && incidences.find(a, b) < 0;
-    };
     const auto plausible_patch = [&]() {
       bool ok = found.size() == k - 2;
       for (const auto& t : found)
@@ -195,6 +195,63 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
         patch.push_back({hole[t.v[0]], hole[t.v[1]], hole[t.v[2]]});
       }
     return closed;
+  };
+
+  std::vector<std::uint8_t> edge_ok;
+  detail::LeastPerimeterScratch scratch;
+  std::vector<std::pair<std::array<int, 2>, Eigen::Vector3d>> normal_at;
+  const auto normal = [&](const Triangle& t) {
+    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+  };
+  const auto least_perimeter_patch = [&](std::vector<Triangle>& patch) {
+    const std::size_t k = hole.size();
+    if (k > LEAST_PERIMETER_EDGES)
+      return false;
+    edge_ok.assign(k * k, 0);
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 1; j < k; ++j)
+        edge_ok[i * k + j] = plausible(i, j);
+    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
+      return edge_ok[i * k + m] && edge_ok[m * k + j] && edge_ok[i * k + j];
+    };
+    const std::size_t first = patch.size();
+    if (!detail::leastPerimeterTriangulation(points, hole, valid, patch, scratch))
+      return false;
+    // No fold: at every edge the two triangles, the patch's or the mesh's beside
+    // the loop, face within FOLD_COSINE of each other.
+    normal_at.clear();
+    for (std::size_t i = 0; i < k; ++i) {
+      const int a = hole[i], b = hole[(i + 1) % k];
+      normal_at.push_back({edgeKey(a, b), normal(beside(a, b))});
+    }
+    for (std::size_t t = first; t < patch.size(); ++t)
+      for (int c = 0; c < 3; ++c)
+        normal_at.push_back(
+            {edgeKey(patch[t][c], patch[t][(c + 1) % 3]), normal(patch[t])});
+    std::sort(normal_at.begin(), normal_at.end(), [](const auto& x, const auto& y) {
+      return x.first < y.first;
+    });
+    bool folds = false;
+    for (std::size_t i = 0; i < normal_at.size() && !folds; ++i) {
+      const Eigen::Vector3d& n = normal_at[i].second;
+      folds =
+          !(n.squaredNorm() > 0.0) ||
+          (i + 1 < normal_at.size() && normal_at[i + 1].first == normal_at[i].first &&
+           !(n.dot(normal_at[i + 1].second) >
+             FOLD_COSINE * n.norm() * normal_at[i + 1].second.norm()));
+    }
+    if (folds)
+      patch.resize(first);
+    return !folds;
+  };
+
+  const auto patch_of = [&](const std::vector<int>& loop,
+                            std::vector<Triangle>& patch) {
+    // The hole runs against the loop, which has the mesh on its left: a triangle of
+    // the hole's polygon with its corners in the hole's order faces as the mesh.
+    hole.assign(loop.rbegin(), loop.rend());
+    return weight == HoleWeight::LEAST_PERIMETER ? least_perimeter_patch(patch)
+                                                 : dihedral_patch(patch);
   };
   return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
 }
@@ -942,70 +999,6 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
     for (const int q : inner)
       used[q] = 1;
     return !patch.empty();
-  };
-  return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
-}
-
-HoleFilling
-fillHolesWithLeastPerimeter(const std::vector<Eigen::Vector3d>& points,
-                            const std::vector<double>& spacing,
-                            std::vector<Triangle>& triangles,
-                            EdgeIncidences& incidences,
-                            std::vector<std::vector<int>>& loops,
-                            double reach,
-                            std::size_t max_edges,
-                            const std::vector<std::uint8_t>& true_border)
-{
-  std::vector<std::uint8_t> new_edge_ok;
-  std::vector<Triangle> found;
-  std::map<std::array<int, 2>, Eigen::Vector3d> normal_at;
-  const auto normal = [&](const Triangle& t) {
-    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
-  };
-  const auto patch_of = [&](const std::vector<int>& loop,
-                            std::vector<Triangle>& patch) {
-    const std::size_t k = loop.size();
-    if (k > LEAST_PERIMETER_EDGES)
-      return false;
-    // The hole runs against the loop: its triangles in the hole's order face as the
-    // mesh. A new edge must be within the reach and new to the mesh.
-    const std::vector<int> hole(loop.rbegin(), loop.rend());
-    new_edge_ok.assign(k * k, 0);
-    for (std::size_t i = 0; i < k; ++i)
-      for (std::size_t j = i + 1; j < k; ++j)
-        new_edge_ok[i * k + j] =
-            j == i + 1 || (i == 0 && j == k - 1) ||
-            (withinReach(points, spacing, reach, hole[i], hole[j]) &&
-             incidences.find(hole[i], hole[j]) < 0);
-    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
-      return new_edge_ok[i * k + m] && new_edge_ok[m * k + j] && new_edge_ok[i * k + j];
-    };
-    found.clear();
-    if (!detail::leastPerimeterTriangulation(points, hole, valid, found))
-      return false;
-    // No fold: at every edge the patch's triangles and the mesh's beside the loop
-    // face within FOLD_COSINE of each other.
-    normal_at.clear();
-    const auto agrees = [&](int a, int b, const Eigen::Vector3d& n) {
-      const auto [it, first] = normal_at.emplace(edgeKey(a, b), n);
-      return first || n.dot(it->second) > FOLD_COSINE * n.norm() * it->second.norm();
-    };
-    for (std::size_t i = 0; i < k; ++i) {
-      const int a = loop[i], b = loop[(i + 1) % k];
-      const auto e = incidences.find(a, b);
-      normal_at.emplace(edgeKey(a, b),
-                        normal(triangles[incidences.triangle[incidences.first[e]]]));
-    }
-    for (const Triangle& t : found) {
-      const Eigen::Vector3d n = normal(t);
-      if (!(n.squaredNorm() > 0.0))
-        return false;
-      for (int c = 0; c < 3; ++c)
-        if (!agrees(t[c], t[(c + 1) % 3], n))
-          return false;
-    }
-    patch.insert(patch.end(), found.begin(), found.end());
-    return true;
   };
   return closeLoops(triangles, incidences, loops, max_edges, true_border, patch_of);
 }

@@ -16,6 +16,14 @@ namespace pcl {
 namespace cocone {
 namespace detail {
 
+/** The tables of leastPerimeterTriangulation(), kept between calls so that closing
+ * many small holes allocates once. */
+struct LeastPerimeterScratch {
+  std::vector<double> cost, length;
+  std::vector<int> split;
+  std::vector<std::array<std::size_t, 2>> stack;
+};
+
 /** The triangulation of a closed polygon (a hole's loop) with the least total
  * perimeter among those made of triangles \a valid (i, m, j) accepts, i < m < j
  * positions in \a loop: dynamic programming over the polygon's sub-chains, cubic in
@@ -30,16 +38,19 @@ bool
 leastPerimeterTriangulation(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<int>& loop,
                             const Valid& valid,
-                            std::vector<std::array<int, 3>>& out)
+                            std::vector<std::array<int, 3>>& out,
+                            LeastPerimeterScratch& scratch)
 {
   const std::size_t k = loop.size();
   if (k < 3)
     return false;
   const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> cost(k * k, inf);
-  std::vector<int> split(k * k, -1);
-  // The loop's pairwise distances, once (the search reads each k times).
-  std::vector<double> length(k * k, 0.0);
+  auto& cost = scratch.cost;
+  auto& split = scratch.split;
+  auto& length = scratch.length; // the loop's pairwise distances, read k times each
+  cost.assign(k * k, inf);
+  split.assign(k * k, -1);
+  length.assign(k * k, 0.0);
   for (std::size_t i = 0; i < k; ++i)
     for (std::size_t j = i + 1; j < k; ++j)
       length[i * k + j] = (points[loop[i]] - points[loop[j]]).norm();
@@ -61,7 +72,8 @@ leastPerimeterTriangulation(const std::vector<Eigen::Vector3d>& points,
     }
   if (!(cost[k - 1] < inf))
     return false;
-  std::vector<std::array<std::size_t, 2>> stack(1, {0, k - 1});
+  auto& stack = scratch.stack;
+  stack.assign(1, {0, k - 1});
   while (!stack.empty()) {
     const auto [i, j] = stack.back();
     stack.pop_back();

@@ -198,14 +198,19 @@ reconstruct(Triangulation& dt,
       result.filled_holes.insert(
           result.filled_holes.end(), closed.rims.begin(), closed.rims.end());
     };
-    record(fillUndersampledHoles(dt.points,
-                                 spacing,
-                                 result.triangles,
-                                 incidences,
-                                 result.border_loops,
-                                 parameters.hole_reach,
-                                 parameters.max_hole_edges,
-                                 true_border));
+    // The loops closed with triangles of their own vertices, weighed by weight.
+    const auto patch_loops = [&](HoleWeight weight) {
+      record(fillUndersampledHoles(dt.points,
+                                   spacing,
+                                   result.triangles,
+                                   incidences,
+                                   result.border_loops,
+                                   parameters.hole_reach,
+                                   parameters.max_hole_edges,
+                                   true_border,
+                                   weight));
+    };
+    patch_loops(HoleWeight::DIHEDRAL_ANGLES);
     // What the Delaunay patches leave (loops, points in no triangle) the original
     // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
     // coarsely for the flatness test. What those leave, the advancing front's may:
@@ -292,14 +297,7 @@ reconstruct(Triangulation& dt,
                                          true_border,
                                          threads));
     // Long narrow holes left, closed by the strip across them.
-    record(fillHolesWithLeastPerimeter(dt.points,
-                                       spacing,
-                                       result.triangles,
-                                       incidences,
-                                       result.border_loops,
-                                       parameters.hole_reach,
-                                       parameters.max_hole_edges,
-                                       true_border));
+    patch_loops(HoleWeight::LEAST_PERIMETER);
     // The borders left through the samples on them.
     counts.repair.peeled =
         peelBorderSlivers(dt.points, result.triangles, incidences, result.border_loops);

@@ -422,6 +422,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
   std::sort(starts.begin(), starts.end());
   std::vector<std::uint8_t> done(num_vertices, 0);
   std::vector<int> loop;
+  detail::LeastPerimeterScratch scratch;
   std::size_t added = 0;
   for (const int x : starts) {
     if (done[x])
@@ -449,7 +450,7 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
              !(diagonal(i, j) && edge_id(loop[i], loop[j]) >= 0);
     };
     const std::size_t size = triangles.size();
-    if (detail::leastPerimeterTriangulation(points, loop, valid, triangles))
+    if (detail::leastPerimeterTriangulation(points, loop, valid, triangles, scratch))
       added += triangles.size() - size;
   }
   if (incidences && &inc == &grouped)

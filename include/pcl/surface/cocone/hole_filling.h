@@ -30,20 +30,34 @@ struct HoleFilling {
   std::vector<std::vector<int>> rims;
 };
 
+/** \brief How fillUndersampledHoles() weighs the triangulations of a loop. */
+enum class HoleWeight {
+  /** CGAL's triangulate_hole_polyline(): Liepa's minimum-weight triangulation (the
+   * largest dihedral angle, then the area) over the 3D Delaunay faces of the loop's
+   * vertices, and over all their triangles for loops of up to 40 edges; the patch is
+   * then checked against the reach. */
+  DIHEDRAL_ANGLES,
+  /** The least total edge length among the triangulations whose new edges are
+   * within the reach, unless it folds (two of its triangles, or one and the mesh's
+   * beside the loop, facing more than 150 degrees apart); loops of up to 128 edges
+   * (the search is cubic). Across a long narrow hole, such as a slit along the rim of
+   * a plate thinner than the spacing, the dihedral angles prefer a fan of long edges
+   * from one end (3 to 4.7 spacings measured), the length the strip across it. */
+  LEAST_PERIMETER
+};
+
 /** \brief Close the border loops that are undersampled holes, not true borders
  * (the question Dey & Giesen leave open).
  *
  * A true border is where the sampled surface ends: across it there is nothing to
  * connect to within the sampling's resolution. An undersampled hole has samples all
  * around it that continue the surface, so it can be closed by triangles as short as
- * the sample spacing there: a loop is closed when CGAL's triangulate_hole_polyline()
- * (Liepa's minimum-weight triangulation over the 3D Delaunay faces of the loop's
- * vertices, weighted against folding over the triangles beside the loop) finds a
- * patch all of whose new edges are at most \a reach times the larger local spacing
- * of their ends (the plausibility of the advancing front, whose radius ratio bound
- * asks the same of a candidate triangle against its neighbour's) and none of which
- * the mesh has already. No new vertex; the patch faces as the loop's triangles do,
- * so the mesh stays an oriented 2-manifold.
+ * the sample spacing there: a loop is closed when the triangulation of its polygon
+ * that \a weight prefers has all its new edges at most \a reach times the larger
+ * local spacing of their ends (the plausibility of the advancing front, whose radius
+ * ratio bound asks the same of a candidate triangle against its neighbour's) and
+ * none of them in the mesh already. No new vertex; the patch faces as the loop's
+ * triangles do, so the mesh stays an oriented 2-manifold.
  *
  * Assumes that the spacing along a true border is not more than 1 / reach times the
  * width of what it encloses: a true hole narrower than about reach spacings is
@@ -59,6 +73,9 @@ struct HoleFilling {
  *                grows with the loop)
  * \param[in] true_border per vertex: on a true border (classifyBorderLoops()), whose
  *                loop stays open; empty: none
+ * \param[in] weight which triangulation of a loop is tried: the pipeline tries the
+ *                dihedral angles first and the least perimeter on the loops every
+ *                other patch has left
  */
 HoleFilling
 fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
@@ -68,7 +85,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       std::vector<std::vector<int>>& loops,
                       double reach,
                       std::size_t max_edges,
-                      const std::vector<std::uint8_t>& true_border = {});
+                      const std::vector<std::uint8_t>& true_border = {},
+                      HoleWeight weight = HoleWeight::DIHEDRAL_ANGLES);
 
 /** \brief Close border loops, and cover points no triangle uses, with the triangles
  * another mesh of the same vertices has there: the original Co-cone's, every vertex
@@ -217,40 +235,6 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
                               std::size_t max_edges,
                               const std::vector<std::uint8_t>& true_border = {},
                               int threads = 1);
-
-/** \brief Close the loops every other patch left open with the triangulation of the
- * loop's polygon of least total edge length among those whose new edges are within
- * the reach and new to the mesh, if it does not fold (at each of its edges the two
- * triangles, the patch's or the mesh's beside the loop, face within 150 degrees of
- * each other). No new vertex; the patch faces as the mesh.
- *
- * The last patch: CGAL's triangulate_hole_polyline() (fillUndersampledHoles())
- * weighs the dihedral angles first (Liepa), which across a long narrow hole, such as
- * a slit along the rim of a plate thinner than the spacing (its two sheets come
- * within a spacing there, and the walk leaves the rim open in stretches), prefers a
- * fan of long edges from one end to the short strip across it. Weighing length
- * finds the strip. Assumes, as the other patches do, that a true hole is wider
- * than the reach.
- * \param[in] points the vertex positions
- * \param[in] spacing per vertex its local spacing (localSpacing())
- * \param[in,out] triangles the oriented manifold mesh; the patches are appended
- * \param[in,out] incidences the mesh's edge incidences, kept up to date
- * \param[in,out] loops the mesh's border loops; the closed ones are taken out
- * \param[in] reach the longest new edge allowed, in local spacings
- * \param[in] max_edges loops longer than this (or than 128 edges: the search is
- *            cubic in the edges) are left open
- * \param[in] true_border per vertex: on a true border, whose loop stays open;
- *            empty: none
- */
-HoleFilling
-fillHolesWithLeastPerimeter(const std::vector<Eigen::Vector3d>& points,
-                            const std::vector<double>& spacing,
-                            std::vector<Triangle>& triangles,
-                            EdgeIncidences& incidences,
-                            std::vector<std::vector<int>>& loops,
-                            double reach,
-                            std::size_t max_edges,
-                            const std::vector<std::uint8_t>& true_border = {});
 
 } // namespace cocone
 } // namespace pcl
