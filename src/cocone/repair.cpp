@@ -351,7 +351,8 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
                RepairCounts& counts,
                int threads,
-               EdgeIncidences* incidences)
+               EdgeIncidences* incidences,
+               const std::vector<std::uint8_t>* whole_stars)
 {
   // Grouped once: each step that drops triangles takes them out of the grouping.
   EdgeIncidences inc = incidences && incidences->grouped()
@@ -367,9 +368,12 @@ repairManifold(const std::vector<Eigen::Vector3d>& points,
     std::vector<std::uint8_t> touched, again;
     std::size_t dropped = 0;
     std::size_t d =
-        resolveVertices(triangles, inc, points.size(), threads, nullptr, touched);
+        resolveVertices(triangles, inc, points.size(), threads, whole_stars, touched);
     while (d > 0) {
       dropped += d;
+      if (whole_stars)
+        for (std::size_t v = 0; v < touched.size(); ++v)
+          touched[v] &= (*whole_stars)[v];
       d = resolveVertices(triangles, inc, points.size(), threads, &touched, again);
       touched.swap(again);
     }

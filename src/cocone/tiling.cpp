@@ -15,6 +15,7 @@
 #include "edge_sort.h"
 #include "parallel.h"
 #include "stopwatch.h"
+#include "tiles.h"
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,263 +36,14 @@
 namespace pcl {
 namespace cocone {
 
+namespace detail {
+
 namespace {
 
-/** Seam holes of up to this many edges are closed with the tiles' triangles: where
- * two tiles disagree the gap is a triangle or two (loops of 3 to 6 edges). */
-constexpr std::size_t SEAM_HOLE_EDGES = 12;
 /** Points sampled for a tile's spacing. */
 constexpr std::size_t SPACING_SAMPLES = 512;
 
-/** The position in the points of each caller id. */
-class IdIndex {
-public:
-  /** False (with \a error) if the ids are not distinct. \a count: the number of
-   * points, which are their own ids when \a ids is empty. */
-  bool
-  build(const std::vector<int>& ids, std::size_t count, std::string& error)
-  {
-    ids_ = &ids;
-    count_ = count;
-    if (ids.empty())
-      return true;
-    const auto [lo, hi] = std::minmax_element(ids.begin(), ids.end());
-    low_ = *lo;
-    const auto range = static_cast<std::uint64_t>(static_cast<std::int64_t>(*hi) - *lo);
-    if (range < 4 * static_cast<std::uint64_t>(ids.size()) + 1024) {
-      dense_.assign(range + 1, -1);
-      for (std::size_t i = 0; i < ids.size(); ++i) {
-        int& slot = dense_[static_cast<std::size_t>(ids[i] - low_)];
-        if (slot >= 0) {
-          error = "the ids are not distinct (" + std::to_string(ids[i]) + " twice)";
-          return false;
-        }
-        slot = static_cast<int>(i);
-      }
-      return true;
-    }
-    sorted_.reserve(ids.size());
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      sorted_.emplace_back(ids[i], static_cast<int>(i));
-    std::sort(sorted_.begin(), sorted_.end());
-    for (std::size_t i = 1; i < sorted_.size(); ++i)
-      if (sorted_[i].first == sorted_[i - 1].first) {
-        error =
-            "the ids are not distinct (" + std::to_string(sorted_[i].first) + " twice)";
-        return false;
-      }
-    return true;
-  }
-
-  /** The ids it was built with (empty: the positions). */
-  const std::vector<int>&
-  all() const
-  {
-    return *ids_;
-  }
-
-  int
-  id(std::size_t position) const
-  {
-    return ids_->empty() ? static_cast<int>(position) : (*ids_)[position];
-  }
-
-  /** The position of \a id (one of the ids). */
-  int
-  position(int id) const
-  {
-    if (ids_->empty())
-      return id;
-    if (!dense_.empty())
-      return dense_[static_cast<std::size_t>(static_cast<std::int64_t>(id) - low_)];
-    const auto it =
-        std::lower_bound(sorted_.begin(),
-                         sorted_.end(),
-                         std::make_pair(id, std::numeric_limits<int>::min()));
-    return it->second;
-  }
-
-  /** Whether \a id is one of the ids. */
-  bool
-  contains(int id) const
-  {
-    if (ids_->empty())
-      return id >= 0 && static_cast<std::size_t>(id) < count_;
-    if (!dense_.empty()) {
-      const std::int64_t k = static_cast<std::int64_t>(id) - low_;
-      return k >= 0 && static_cast<std::size_t>(k) < dense_.size() &&
-             dense_[static_cast<std::size_t>(k)] >= 0;
-    }
-    const auto it =
-        std::lower_bound(sorted_.begin(),
-                         sorted_.end(),
-                         std::make_pair(id, std::numeric_limits<int>::min()));
-    return it != sorted_.end() && it->first == id;
-  }
-
-private:
-  const std::vector<int>* ids_ = nullptr;
-  std::size_t count_ = 0;
-  int low_ = 0;
-  std::vector<int> dense_;
-  std::vector<std::pair<int, int>> sorted_;
-};
-
-struct Box {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::max());
-
-  void
-  extend(const Eigen::Vector3d& p)
-  {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-
-  double
-  distance(const Eigen::Vector3d& p) const
-  {
-    return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
-  }
-
-  double
-  distance(const Box& b) const
-  {
-    return (lo - b.hi).cwiseMax(b.lo - hi).cwiseMax(0.0).norm();
-  }
-};
-
-/** The tiles: a k-d tree of median splits over the finite points, its leaves the
- * cores. */
-class Tiles {
-public:
-  struct Node {
-    std::size_t begin = 0, end = 0; ///< range of order
-    Box box;                        ///< of the node's points
-    int left = -1, right = -1;      ///< children; -1 at a leaf
-  };
-
-  Tiles(const std::vector<Eigen::Vector3d>& points,
-        std::vector<int> finite,
-        std::size_t tile_points)
-  : points_(points), order_(std::move(finite)), tile_points_(tile_points)
-  {
-    nodes_.reserve(4 * (order_.size() / tile_points + 1));
-    nodes_.emplace_back();
-    nodes_[0].end = order_.size();
-    split(0);
-  }
-
-  std::size_t
-  size() const
-  {
-    return leaves_.size();
-  }
-
-  const Node&
-  core(std::size_t tile) const
-  {
-    return nodes_[leaves_[tile]];
-  }
-
-  const std::vector<int>&
-  order() const
-  {
-    return order_;
-  }
-
-  /** The order, moved out: the tiles are of no further use. */
-  std::vector<int>
-  takeOrder()
-  {
-    return std::move(order_);
-  }
-
-  /** The positions of the points not in \a tile's core within \a reach of its box,
-   * in the order of the tiles. */
-  std::vector<int>
-  halo(std::size_t tile, double reach) const
-  {
-    std::vector<int> out;
-    const int own = leaves_[tile];
-    const Box& box = nodes_[own].box;
-    std::vector<int> stack{0};
-    while (!stack.empty()) {
-      const int n = stack.back();
-      stack.pop_back();
-      const Node& node = nodes_[n];
-      if (n == own || node.box.distance(box) > reach)
-        continue;
-      if (node.left >= 0) {
-        stack.push_back(node.right); // the left child first
-        stack.push_back(node.left);
-        continue;
-      }
-      for (std::size_t i = node.begin; i < node.end; ++i)
-        if (box.distance(points_[order_[i]]) <= reach)
-          out.push_back(order_[i]);
-    }
-    return out;
-  }
-
-private:
-  void
-  split(int n)
-  {
-    const std::size_t begin = nodes_[n].begin, end = nodes_[n].end;
-    Box box;
-    for (std::size_t i = begin; i < end; ++i)
-      box.extend(points_[order_[i]]);
-    nodes_[n].box = box;
-    const Eigen::Vector3d extent = box.hi - box.lo;
-    int axis = 0;
-    extent.maxCoeff(&axis);
-    if (end - begin <= tile_points_ || !(extent[axis] > 0.0)) {
-      leaves_.push_back(n);
-      return;
-    }
-    // Along the axis, then by the other coordinates: exact duplicates compare equal
-    // and are kept on one side, so that a vertex has one core.
-    const auto less = [&](int a, int b) {
-      const Eigen::Vector3d &p = points_[a], &q = points_[b];
-      if (p[axis] != q[axis])
-        return p[axis] < q[axis];
-      return std::lexicographical_compare(
-          p.data(), p.data() + 3, q.data(), q.data() + 3);
-    };
-    const auto first = order_.begin() + static_cast<std::ptrdiff_t>(begin);
-    const auto last = order_.begin() + static_cast<std::ptrdiff_t>(end);
-    auto middle = first + static_cast<std::ptrdiff_t>((end - begin) / 2);
-    std::nth_element(first, middle, last, less);
-    const int pivot = *middle;
-    // The pivot's duplicates go right, or left when all of the left are such.
-    auto cut = std::partition(first, middle, [&](int i) { return less(i, pivot); });
-    if (cut == first)
-      cut = std::partition(middle, last, [&](int i) { return !less(pivot, i); });
-    if (cut == first || cut == last) {
-      leaves_.push_back(n);
-      return;
-    }
-    const auto mid = static_cast<std::size_t>(cut - order_.begin());
-    const int left = static_cast<int>(nodes_.size());
-    nodes_.emplace_back();
-    nodes_.emplace_back();
-    nodes_[n].left = left;
-    nodes_[n].right = left + 1;
-    nodes_[left].begin = begin;
-    nodes_[left].end = mid;
-    nodes_[left + 1].begin = mid;
-    nodes_[left + 1].end = end;
-    split(left);
-    split(left + 1);
-  }
-
-  const std::vector<Eigen::Vector3d>& points_;
-  std::vector<int> order_;
-  std::size_t tile_points_;
-  std::vector<Node> nodes_;
-  std::vector<int> leaves_;
-};
+} // namespace
 
 /** The median distance of the points of \a index to their nearest other point (a
  * distinct one), over an even sample of them; 0 if all coincide. A grid of cells
@@ -404,43 +156,6 @@ median(std::vector<double> v)
   return *m;
 }
 
-/** Run \a body(t) for t in [0, count) on up to \a workers threads, each tile on one
- * of them, the next tile to the first thread free. */
-template <typename Body>
-void
-forEachTile(std::size_t count, int workers, const Body& body)
-{
-  if (workers <= 1) {
-    for (std::size_t t = 0; t < count; ++t)
-      body(t);
-    return;
-  }
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t t = next++; t < count; t = next++)
-      body(t);
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(workers));
-  try {
-    for (int w = 0; w < workers; ++w)
-      pool.emplace_back(work);
-  }
-  catch (...) { // a thread that could not start: the others finish the tiles
-    for (auto& thread : pool)
-      thread.join();
-    throw;
-  }
-  for (auto& thread : pool)
-    thread.join();
-}
-
-/** One entry per hole among the holes the tiles closed, each given as (whether
- * another tile owns its rim's lowest id, its rim). A hole near a seam is closed by
- * each tile that sees it, and tiles may disagree on where a hole is (the triangles
- * round it differ): the rims are taken owners' first, then in their order, and one
- * that shares a point with a rim taken is the same hole (a point is on one loop of a
- * mesh). */
 std::vector<std::vector<int>>
 distinctHoles(std::vector<std::pair<bool, std::vector<int>>> candidates)
 {
@@ -457,6 +172,165 @@ distinctHoles(std::vector<std::pair<bool, std::vector<int>>> candidates)
   detail::sortLoops(holes);
   return holes;
 }
+
+std::vector<std::uint8_t>
+turnPatches(const EdgeIncidences& incidences,
+            const std::vector<int>& patch,
+            std::size_t patches)
+{
+  std::vector<std::array<int, 3>> votes; // patch, patch, 1 if they agree
+  for (std::size_t e = 0; e < incidences.edges.size(); ++e) {
+    if (incidences.count(e) != 2)
+      continue;
+    const std::size_t i = incidences.first[e];
+    const int a = patch[incidences.triangle[i]], b = patch[incidences.triangle[i + 1]];
+    if (a != b)
+      votes.push_back({std::min(a, b),
+                       std::max(a, b),
+                       incidences.forward[i] != incidences.forward[i + 1]});
+  }
+  std::sort(votes.begin(), votes.end());
+  struct Pair {
+    int a, b;
+    long agree, disagree;
+  };
+  std::vector<Pair> pairs;
+  for (const auto& v : votes) {
+    if (pairs.empty() || pairs.back().a != v[0] || pairs.back().b != v[1])
+      pairs.push_back({v[0], v[1], 0, 0});
+    (v[2] ? pairs.back().agree : pairs.back().disagree) += 1;
+  }
+  std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) {
+    return std::abs(x.agree - x.disagree) > std::abs(y.agree - y.disagree);
+  });
+  ConcurrentParitySets sets(patches, 1);
+  for (const Pair& p : pairs)
+    if (p.agree != p.disagree)
+      sets.unite(p.a, p.b, p.disagree > p.agree ? 1 : 0);
+  std::vector<std::uint8_t> turn(patches, 0);
+  for (std::size_t c = 0; c < patches; ++c)
+    turn[c] = static_cast<std::uint8_t>(sets.find(static_cast<int>(c)).parity);
+  return turn;
+}
+
+void
+turnNormal(Eigen::Vector3d& normal, const Eigen::Vector3d& facing, bool recompute)
+{
+  if (facing.squaredNorm() == 0.0)
+    normal = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  else if (recompute || !normal.allFinite())
+    normal = facing.normalized();
+  else if (normal.dot(facing) < 0.0)
+    normal = -normal;
+}
+
+} // namespace detail
+
+namespace {
+
+using detail::add;
+using detail::Box;
+using detail::distinctHoles;
+using detail::forEachTile;
+using detail::median;
+using detail::medianSpacing;
+using detail::SEAM_HOLE_EDGES;
+using detail::tileBytes;
+using detail::Tiles;
+
+/** The position in the points of each caller id. */
+class IdIndex {
+public:
+  /** False (with \a error) if the ids are not distinct. \a count: the number of
+   * points, which are their own ids when \a ids is empty. */
+  bool
+  build(const std::vector<int>& ids, std::size_t count, std::string& error)
+  {
+    ids_ = &ids;
+    count_ = count;
+    if (ids.empty())
+      return true;
+    const auto [lo, hi] = std::minmax_element(ids.begin(), ids.end());
+    low_ = *lo;
+    const auto range = static_cast<std::uint64_t>(static_cast<std::int64_t>(*hi) - *lo);
+    if (range < 4 * static_cast<std::uint64_t>(ids.size()) + 1024) {
+      dense_.assign(range + 1, -1);
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        int& slot = dense_[static_cast<std::size_t>(ids[i] - low_)];
+        if (slot >= 0) {
+          error = "the ids are not distinct (" + std::to_string(ids[i]) + " twice)";
+          return false;
+        }
+        slot = static_cast<int>(i);
+      }
+      return true;
+    }
+    sorted_.reserve(ids.size());
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      sorted_.emplace_back(ids[i], static_cast<int>(i));
+    std::sort(sorted_.begin(), sorted_.end());
+    for (std::size_t i = 1; i < sorted_.size(); ++i)
+      if (sorted_[i].first == sorted_[i - 1].first) {
+        error =
+            "the ids are not distinct (" + std::to_string(sorted_[i].first) + " twice)";
+        return false;
+      }
+    return true;
+  }
+
+  /** The ids it was built with (empty: the positions). */
+  const std::vector<int>&
+  all() const
+  {
+    return *ids_;
+  }
+
+  int
+  id(std::size_t position) const
+  {
+    return ids_->empty() ? static_cast<int>(position) : (*ids_)[position];
+  }
+
+  /** The position of \a id (one of the ids). */
+  int
+  position(int id) const
+  {
+    if (ids_->empty())
+      return id;
+    if (!dense_.empty())
+      return dense_[static_cast<std::size_t>(static_cast<std::int64_t>(id) - low_)];
+    const auto it =
+        std::lower_bound(sorted_.begin(),
+                         sorted_.end(),
+                         std::make_pair(id, std::numeric_limits<int>::min()));
+    return it->second;
+  }
+
+  /** Whether \a id is one of the ids. */
+  bool
+  contains(int id) const
+  {
+    if (ids_->empty())
+      return id >= 0 && static_cast<std::size_t>(id) < count_;
+    if (!dense_.empty()) {
+      const std::int64_t k = static_cast<std::int64_t>(id) - low_;
+      return k >= 0 && static_cast<std::size_t>(k) < dense_.size() &&
+             dense_[static_cast<std::size_t>(k)] >= 0;
+    }
+    const auto it =
+        std::lower_bound(sorted_.begin(),
+                         sorted_.end(),
+                         std::make_pair(id, std::numeric_limits<int>::min()));
+    return it != sorted_.end() && it->first == id;
+  }
+
+private:
+  const std::vector<int>* ids_ = nullptr;
+  std::size_t count_ = 0;
+  int low_ = 0;
+  std::vector<int> dense_;
+  std::vector<std::pair<int, int>> sorted_;
+};
 
 /** The stitch of stitchTiles(), on checked input. */
 Result
@@ -618,41 +492,11 @@ stitch(TilePlan& plan,
   // joins two sets decides them).
   EdgeIncidences incidences(triangles, threads);
   {
-    std::vector<std::array<int, 3>> votes; // patch, patch, 1 if they agree
-    for (std::size_t e = 0; e < incidences.edges.size(); ++e) {
-      if (incidences.count(e) != 2)
-        continue;
-      const std::size_t i = incidences.first[e];
-      const int a = patch[incidences.triangle[i]],
-                b = patch[incidences.triangle[i + 1]];
-      if (a != b)
-        votes.push_back({std::min(a, b),
-                         std::max(a, b),
-                         incidences.forward[i] != incidences.forward[i + 1]});
-    }
-    std::sort(votes.begin(), votes.end());
-    struct Pair {
-      int a, b;
-      long agree, disagree;
-    };
-    std::vector<Pair> pairs;
-    for (const auto& v : votes) {
-      if (pairs.empty() || pairs.back().a != v[0] || pairs.back().b != v[1])
-        pairs.push_back({v[0], v[1], 0, 0});
-      (v[2] ? pairs.back().agree : pairs.back().disagree) += 1;
-    }
-    std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) {
-      return std::abs(x.agree - x.disagree) > std::abs(y.agree - y.disagree);
-    });
-    detail::ConcurrentParitySets sets(patches, 1);
-    for (const Pair& p : pairs)
-      if (p.agree != p.disagree)
-        sets.unite(p.a, p.b, p.disagree > p.agree ? 1 : 0);
-    std::vector<std::uint8_t> turn(patches, 0), turned(triangles.size(), 0);
-    for (std::size_t c = 0; c < patches; ++c) {
-      turn[c] = static_cast<std::uint8_t>(sets.find(static_cast<int>(c)).parity);
+    const std::vector<std::uint8_t> turn =
+        detail::turnPatches(incidences, patch, patches);
+    std::vector<std::uint8_t> turned(triangles.size(), 0);
+    for (std::size_t c = 0; c < patches; ++c)
       report.patches_flipped += turn[c];
-    }
     for (std::size_t t = 0; t < triangles.size(); ++t)
       if (turn[patch[t]]) {
         std::swap(triangles[t][1], triangles[t][2]);
@@ -732,16 +576,9 @@ stitch(TilePlan& plan,
     for (const int v : t)
       facing[v] += a;
   }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t v = 0; v < nv; ++v) {
-    Eigen::Vector3d& normal = result.normals[v];
-    if (facing[v].squaredNorm() == 0.0)
-      normal = Eigen::Vector3d::Constant(nan);
-    else if (result.boundary[v] || result.umbrella_failed[v] || !normal.allFinite())
-      normal = facing[v].normalized();
-    else if (normal.dot(facing[v]) < 0.0)
-      normal = -normal;
-  }
+  for (std::size_t v = 0; v < nv; ++v)
+    detail::turnNormal(
+        result.normals[v], facing[v], result.boundary[v] || result.umbrella_failed[v]);
 
   report.point_tile = std::move(plan.point_tile);
   detail::meshToCallerIds(result);
@@ -809,17 +646,34 @@ availableMemory()
   return available;
 }
 
-namespace {
+namespace {} // namespace
 
-/** Memory a tile of \a core points takes in flight: its halo adds about a quarter (8
- * spacings round a million points: 10 to 20 %). */
+namespace detail {
+
 double
 tileBytes(double core)
 {
   return 1.25 * static_cast<double>(ONE_PIECE_BYTES_PER_POINT) * core;
 }
 
-} // namespace
+std::size_t
+seriesTilePoints(double core)
+{
+  // Down to the series (Renard's R10), in whole points.
+  static const int series[] = {100, 125, 160, 200, 250, 320, 400, 500, 630, 800};
+  double decade = 1.0;
+  while (decade * 10.0 <= core)
+    decade *= 10.0;
+  std::size_t tile = MINIMUM_TILE_POINTS;
+  for (const int step : series) {
+    const double candidate = std::floor(decade * step / 100.0);
+    if (candidate <= core && candidate >= static_cast<double>(MINIMUM_TILE_POINTS))
+      tile = static_cast<std::size_t>(candidate);
+  }
+  return tile;
+}
+
+} // namespace detail
 
 std::size_t
 automaticTilePoints(std::size_t points, std::size_t memory, bool* fits)
@@ -836,18 +690,7 @@ automaticTilePoints(std::size_t points, std::size_t memory, bool* fits)
       *fits = false;
     return MINIMUM_TILE_POINTS;
   }
-  // Down to the series (Renard's R10), in whole points.
-  static const int series[] = {100, 125, 160, 200, 250, 320, 400, 500, 630, 800};
-  double decade = 1.0;
-  while (decade * 10.0 <= core)
-    decade *= 10.0;
-  std::size_t tile = MINIMUM_TILE_POINTS;
-  for (const int step : series) {
-    const double candidate = std::floor(decade * step / 100.0);
-    if (candidate <= core && candidate >= static_cast<double>(MINIMUM_TILE_POINTS))
-      tile = static_cast<std::size_t>(candidate);
-  }
-  return tile;
+  return detail::seriesTilePoints(core);
 }
 
 unsigned int

@@ -65,13 +65,17 @@ struct RepairCounts {
  * \param[in,out] incidences if given and not empty, the edge incidences of
  *                \a triangles (grouped here otherwise); if given, on return those of
  *                the repaired triangles, for fillHoles() to go on with
+ * \param[in] whole_stars if given, per vertex whether \a triangles hold its whole
+ *                star: only those are checked for several fans (a part of a mesh,
+ *                cut out, splits the stars at its edge)
  */
 void
 repairManifold(const std::vector<Eigen::Vector3d>& points,
                std::vector<Triangle>& triangles,
                RepairCounts& counts,
                int threads = 1,
-               EdgeIncidences* incidences = nullptr);
+               EdgeIncidences* incidences = nullptr,
+               const std::vector<std::uint8_t>* whole_stars = nullptr);
 
 /** \brief Close border loops of at most \a max_edges edges by triangles that
  * \a allowed accepts (given their vertex ids ascending), oriented with their
