@@ -33,6 +33,25 @@
 
 namespace cocone_app {
 
+std::string
+temporaryName(const std::string& path)
+{
+  const auto slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  return dir + ".partial-" + std::to_string(::getpid()) + "-" + name;
+}
+
+bool
+parseCount(const std::string& token, std::size_t& value)
+{
+  if (token.empty() || token.size() > 12 ||
+      token.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  value = std::stoull(token);
+  return true;
+}
+
 namespace {
 
 bool
@@ -51,32 +70,11 @@ directoryOf(const std::string& path)
   return slash == 0 ? "/" : path.substr(0, slash);
 }
 
-/** A temporary name next to \a path with the same extension. */
-std::string
-temporaryName(const std::string& path)
-{
-  const auto slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
-  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  return dir + ".partial-" + std::to_string(::getpid()) + "-" + name;
-}
-
 std::size_t
 fileSize(const std::string& path)
 {
   std::ifstream f(path, std::ios::binary | std::ios::ate);
   return f ? static_cast<std::size_t>(f.tellg()) : 0;
-}
-
-/** Parse an unsigned integer token strictly. */
-bool
-parseCount(const std::string& token, std::size_t& value)
-{
-  if (token.empty() || token.size() > 12 ||
-      token.find_first_not_of("0123456789") != std::string::npos)
-    return false;
-  value = std::stoull(token);
-  return true;
 }
 
 /** A PCD header PCL's reader can be trusted with: consistent FIELDS, SIZE, TYPE and

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -64,6 +65,17 @@ appendField(pcl::PCLPointCloud2& cloud,
 /** Whether the cloud has a colour field (rgb or rgba). */
 bool
 hasColour(const pcl::PCLPointCloud2& cloud);
+
+/** A temporary name next to \a path with the same extension (a hidden file named
+ * for the process): written there and renamed into place, an output is never seen
+ * half written. */
+std::string
+temporaryName(const std::string& path);
+
+/** Parse an unsigned integer token strictly: digits only, at most 12 (a header's
+ * count; a sign, a fraction or an overflow is not a count). */
+bool
+parseCount(const std::string& token, std::size_t& value);
 
 /** Check before any work that a file can be created at \a path. */
 bool

@@ -7,6 +7,7 @@
  * method can be faster) and to other reconstruction and border detection methods.
  *
  *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED [NOISE]]
+ *   cocone_benchmark generate terrain random N OUT.ply [SEED]
  *   cocone_benchmark convert CLOUD OUT.ply
  *   cocone_benchmark METHOD CLOUD [--truth auto|closed|saddle|none] [--threads T]
  *   cocone_benchmark tiled CLOUD --tile_points N [--halo S] [--in_flight K]
@@ -14,7 +15,9 @@
  *
  * generate writes seeded samples (area-uniform random or evenly spaced) of the torus
  * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2, with Gaussian noise of NOISE
- * sample spacings along the normal; convert writes the finite
+ * sample spacings along the normal, or area-uniform random samples of a terrain with
+ * walls and holes (Terrain: 7 border loops, Euler characteristic -5), streamed, for
+ * clouds larger than the memory; convert writes the finite
  * points of any readable cloud; both as binary PLY of float x, y, z (what the Open3D
  * script reads). METHOD is one of
  *   delaunay             CGAL::Delaunay_triangulation_3 of the points
@@ -561,6 +564,7 @@ usage(const char* program)
 {
   std::fprintf(stderr,
                "usage: %s generate torus|saddle random|even N OUT.ply [SEED [NOISE]]\n"
+               "       %s generate terrain random N OUT.ply [SEED]\n"
                "       %s convert CLOUD OUT.ply\n"
                "       %s delaunay|detect|cocone|gp3|boundary_estimation|"
                "advancing_front CLOUD\n"
@@ -570,8 +574,138 @@ usage(const char* program)
                program,
                program,
                program,
+               program,
                program);
   return 1;
+}
+
+/** The terrain of `generate terrain`: over [-1, 1]^2, rolling ground with five mesas
+ * whose walls rise at up to 84 degrees (logistic steps 0.08 high, 0.002 wide) and
+ * six round holes, one on a mesa: a disk with six holes (7 border loops, Euler
+ * characteristic -5). The same surface at every N, so that runs of different sizes
+ * compare per point. */
+struct Terrain {
+  struct Circle {
+    double x, y, r;
+  };
+  static constexpr double HEIGHT = 0.08, WIDTH = 0.002;
+  std::vector<Circle> mesas{{-0.5, -0.5, 0.25},
+                            {0.5, 0.4, 0.3},
+                            {-0.4, 0.55, 0.15},
+                            {0.45, -0.5, 0.2},
+                            {0.0, 0.0, 0.12}};
+  std::vector<Circle> holes{{-0.75, 0.1, 0.06},
+                            {0.1, -0.75, 0.05},
+                            {0.8, -0.1, 0.07},
+                            {-0.1, 0.85, 0.05},
+                            {0.1, 0.3, 0.04},
+                            {0.55, 0.45, 0.08}};
+
+  /** Height and gradient at (x, y). */
+  double
+  height(double x, double y, Eigen::Vector2d& gradient) const
+  {
+    double z = 0.05 * std::sin(2.1 * x + 0.3) * std::cos(1.7 * y);
+    gradient = {0.105 * std::cos(2.1 * x + 0.3) * std::cos(1.7 * y),
+                -0.085 * std::sin(2.1 * x + 0.3) * std::sin(1.7 * y)};
+    for (const Circle& m : mesas) {
+      const Eigen::Vector2d d(x - m.x, y - m.y);
+      const double r = std::max(d.norm(), 1e-12);
+      const double step = 1.0 / (1.0 + std::exp(-(m.r - r) / WIDTH));
+      z += HEIGHT * step;
+      gradient -= HEIGHT * step * (1.0 - step) / WIDTH * d / r;
+    }
+    return z;
+  }
+
+  bool
+  inHole(double x, double y) const
+  {
+    for (const Circle& h : holes)
+      if (std::hypot(x - h.x, y - h.y) < h.r)
+        return true;
+    return false;
+  }
+
+  /** sqrt(1 + |gradient|^2): the area element. */
+  double
+  areaFactor(double x, double y) const
+  {
+    Eigen::Vector2d g;
+    height(x, y, g);
+    return std::sqrt(1.0 + g.squaredNorm());
+  }
+};
+
+/** Area-uniform random samples of the Terrain, streamed to a binary PLY. */
+int
+generateTerrain(std::size_t n, std::uint64_t seed, const std::string& path)
+{
+  const Terrain terrain;
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    return 1;
+  }
+  std::fprintf(f,
+               "ply\nformat binary_little_endian 1.0\nelement vertex %zu\n"
+               "property float x\nproperty float y\nproperty float z\nend_header\n",
+               n);
+  std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 1;
+  const auto uniform = [&state] { // splitmix64
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  };
+  // Rejection from cells drawn in proportion to a bound of the area element over
+  // them (its largest value on a 5 x 5 grid of the cell, with a margin): the walls
+  // are 50 times steeper than the ground, a single bound would reject 49 of 50.
+  constexpr int CELLS = 512;
+  const double size = 2.0 / CELLS;
+  std::vector<double> bound(CELLS * CELLS), cumulative(CELLS * CELLS);
+  double total = 0.0;
+  for (int i = 0; i < CELLS; ++i)
+    for (int j = 0; j < CELLS; ++j) {
+      double b = 0.0;
+      for (int a = 0; a <= 4; ++a)
+        for (int c = 0; c <= 4; ++c)
+          b = std::max(b,
+                       terrain.areaFactor(-1.0 + (i + a / 4.0) * size,
+                                          -1.0 + (j + c / 4.0) * size));
+      bound[i * CELLS + j] = 1.5 * b;
+      cumulative[i * CELLS + j] = total += 1.5 * b;
+    }
+  std::vector<float> block;
+  bool ok = true;
+  for (std::size_t i = 0; i < n && ok; ++i) {
+    for (;;) {
+      const std::size_t cell = static_cast<std::size_t>(
+          std::upper_bound(cumulative.begin(), cumulative.end(), uniform() * total) -
+          cumulative.begin());
+      const std::size_t c = std::min<std::size_t>(cell, cumulative.size() - 1);
+      const double x = -1.0 + (static_cast<double>(c / CELLS) + uniform()) * size;
+      const double y = -1.0 + (static_cast<double>(c % CELLS) + uniform()) * size;
+      const double accept = uniform() * bound[c];
+      if (terrain.inHole(x, y))
+        continue;
+      Eigen::Vector2d g;
+      const double z = terrain.height(x, y, g);
+      if (accept >= std::sqrt(1.0 + g.squaredNorm()))
+        continue;
+      block.insert(block.end(), {float(x), float(y), float(z)});
+      break;
+    }
+    if (block.size() >= 3 * 65536 || i + 1 == n) {
+      ok = std::fwrite(block.data(), sizeof(float), block.size(), f) == block.size();
+      block.clear();
+    }
+  }
+  if (std::fclose(f) != 0 || !ok) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    return 1;
+  }
+  return 0;
 }
 
 int
@@ -585,6 +719,8 @@ generate(int argc, char** argv)
   o.seed = argc > 6 ? std::strtoull(argv[6], nullptr, 10) : 1;
   o.noise = argc > 7 ? std::strtod(argv[7], nullptr) : 0.0;
   o.even = sampling == "even";
+  if (surface == "terrain" && sampling == "random" && o.noise == 0.0)
+    return generateTerrain(o.n, o.seed, argv[5]);
   if ((surface != "torus" && surface != "saddle") ||
       (sampling != "even" && sampling != "random"))
     return usage(argv[0]);

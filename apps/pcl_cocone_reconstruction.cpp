@@ -16,14 +16,17 @@
 
 #include "cloud_io.h"
 #include "screenshot.h"
+#include "streaming_io.h"
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -48,6 +51,8 @@ struct Options {
   std::size_t tile_points = 0; // one piece
   bool automatic_tiles = true; // tile_points from the memory
   double memory_mb = 0.0;      // planned for; 0: what the machine has available
+  bool out_of_core = false;    // forced; otherwise chosen by the memory
+  std::string work_dir;        // of an out-of-core run; "": the output's directory
   std::string boundary_file, outliers_file, normals_file, report_file, screenshot_file;
 };
 
@@ -93,6 +98,13 @@ printHelp(const char* name)
       "                    fits the memory, else the largest tiles that do\n"
       "  -memory MB        the memory -tile_points auto plans for (default: what the\n"
       "                    machine has available, within the process' cgroup limit)\n"
+      "  -out_of_core      stream the cloud (binary .ply or .pcd) into tiles on disk\n"
+      "                    and the mesh (.ply) out: memory follows the tile, not the\n"
+      "                    cloud. Chosen by -tile_points auto when the cloud does not\n"
+      "                    fit in memory even in tiles; no\n"
+      "                    -boundary, -outliers, -normals, -screenshot, -refine_holes\n"
+      "  -work_dir DIR     where an out-of-core run keeps its files (default: the\n"
+      "                    output's directory; about 70 bytes per point)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
       "  -outliers FILE    write the outliers (in no triangle) as a .pcd with their\n"
@@ -149,6 +161,7 @@ parseOptions(int argc, char** argv)
                               "-threads",
                               "-tile_points",
                               "-memory",
+                              "-work_dir",
                               "-boundary",
                               "-outliers",
                               "-normals",
@@ -158,6 +171,7 @@ parseOptions(int argc, char** argv)
                             "-no_denoise",
                             "-no_fill",
                             "-refine_holes",
+                            "-out_of_core",
                             "-v",
                             "-q",
                             "-h",
@@ -227,6 +241,8 @@ parseOptions(int argc, char** argv)
   o.hole_width = parseNumber(argc, argv, "-hole_width", o.hole_width);
   if (!(o.hole_width >= 0.0))
     fail("-hole_width must be >= 0");
+  o.out_of_core = find_switch(argc, argv, "-out_of_core");
+  parse_argument(argc, argv, "-work_dir", o.work_dir);
   parse_argument(argc, argv, "-boundary", o.boundary_file);
   parse_argument(argc, argv, "-outliers", o.outliers_file);
   parse_argument(argc, argv, "-normals", o.normals_file);
@@ -286,6 +302,122 @@ jsonString(const std::string& text)
   return out + "\"";
 }
 
+/** Reconstruct out of core: the cloud streamed from \a source into tiles on disk in
+ * the work directory, the mesh streamed to the output .ply; writes the report. */
+int
+reconstructOutOfCore(const Options& o,
+                     pcl::cocone::PointSource& source,
+                     const pcl::cocone::TilingOptions& tiling)
+{
+  if (cocone_app::extension(o.output) != "ply")
+    fail("out of core the mesh is written as .ply (got '" + o.output + "')");
+  for (const auto* f :
+       {&o.boundary_file, &o.outliers_file, &o.normals_file, &o.screenshot_file})
+    if (!f->empty())
+      fail("-boundary, -outliers, -normals and -screenshot need the cloud in memory: "
+           "not available out of core (the report lists the boundary and outlier "
+           "indices)");
+  if (o.refine_holes)
+    fail("-refine_holes is not available out of core");
+  std::string directory = o.work_dir;
+  if (directory.empty()) {
+    const auto slash = o.output.find_last_of('/');
+    directory = slash == std::string::npos ? "." : o.output.substr(0, slash + 1);
+  }
+  pcl::cocone::Parameters p;
+  p.ratio = o.ratio;
+  p.spacing_factor = o.spacing_factor;
+  p.gap_angle = o.gap_angle;
+  p.normal_angle = o.normal_angle;
+  p.cocone_angle = o.cocone_angle;
+  p.boundary_detection = o.boundary_detection;
+  p.noise_handling = o.noise_handling;
+  p.fill_undersampled_holes = o.fill_holes;
+  p.hole_width = o.hole_width;
+  p.threads = static_cast<unsigned>(o.threads);
+  print_info("Out of core: tiles of at most %zu points, %u at a time, files in %s.\n",
+             tiling.tile_points,
+             tiling.tiles_in_flight,
+             directory.c_str());
+  pcl::StopWatch total;
+  cocone_app::PlyMeshWriter writer(o.output);
+  const pcl::cocone::OutOfCoreResult r =
+      pcl::cocone::runOutOfCore(source, p, tiling, directory, writer);
+  if (!r.error.empty())
+    fail(r.error);
+  written.push_back(o.output);
+  const double total_ms = total.getTime();
+  print_info("%zu points in %zu tiles (%zu halo points): %zu triangles, %zu border "
+             "loops, %zu undersampled points, %zu undersampled holes closed; cut %.0f "
+             "ms, tiles %.0f ms, stitch and write %.0f ms; work files at most %.0f "
+             "MB.\n",
+             r.points,
+             r.tiling.tiles,
+             r.tiling.halo_points,
+             r.triangles,
+             r.border_loops.size(),
+             r.boundary_indices.size(),
+             r.holes_filled,
+             r.tiling.cut_ms,
+             r.tiling.tiles_ms,
+             r.tiling.stitch_ms,
+             double(r.disk_bytes) / 1048576.0);
+  if (o.noise_handling)
+    print_debug("Noise level %.3f (about sigma in sample spacings), %s; %zu "
+                "outliers.\n",
+                r.noise_level,
+                r.smoothed ? "smoothed in some tiles" : "not smoothed",
+                r.outlier_indices.size());
+  if (!o.report_file.empty()) {
+    std::vector<int> border;
+    for (const auto& loop : r.border_loops)
+      border.insert(border.end(), loop.begin(), loop.end());
+    std::sort(border.begin(), border.end());
+    std::ostringstream out;
+    out.precision(17);
+    out << "{\n  \"input\": " << jsonString(o.input) << ",\n  \"points\": " << r.points
+        << ",\n  \"finite_points\": " << r.finite
+        << ",\n  \"unique_points\": " << r.vertices
+        << ",\n  \"parameters\": {\"ratio\": " << r.ratio
+        << ", \"gap_angle\": " << o.gap_angle
+        << ", \"normal_angle\": " << o.normal_angle
+        << ", \"cocone_angle\": " << o.cocone_angle
+        << ", \"boundary_detection\": " << (o.boundary_detection ? "true" : "false")
+        << ", \"noise_handling\": " << (o.noise_handling ? "true" : "false")
+        << ", \"fill_undersampled_holes\": " << (o.fill_holes ? "true" : "false")
+        << ", \"hole_width\": " << o.hole_width
+        << ", \"refine_filled_holes\": false, \"tile_points\": " << tiling.tile_points
+        << ", \"automatic_tiles\": " << (o.automatic_tiles ? "true" : "false")
+        << ", \"out_of_core\": true, \"tiles_in_flight\": " << tiling.tiles_in_flight
+        << ", \"threads\": " << o.threads
+        << "},\n  \"noise\": {\"level\": " << r.noise_level
+        << ", \"smoothed\": " << (r.smoothed ? "true" : "false")
+        << "},\n  \"outliers\": " << r.outlier_indices.size()
+        << ",\n  \"outlier_indices\": " << jsonList(r.outlier_indices)
+        << ",\n  \"true_borders\": " << r.counts.true_borders
+        << ",\n  \"holes_filled\": " << r.holes_filled
+        << ",\n  \"hole_triangles\": " << r.counts.hole_triangles
+        << ",\n  \"added_points\": 0,\n  \"triangles\": " << r.triangles
+        << ",\n  \"boundary_loops\": " << r.border_loops.size()
+        << ",\n  \"boundary_indices\": " << jsonList(r.boundary_indices)
+        << ",\n  \"border_indices\": " << jsonList(border)
+        << ",\n  \"tiles\": {\"count\": " << r.tiling.tiles
+        << ", \"halo_points\": " << r.tiling.halo_points
+        << ", \"largest\": " << r.tiling.largest_tile
+        << ", \"patches_flipped\": " << r.tiling.patches_flipped
+        << ", \"seam_filled\": " << r.tiling.seam_filled
+        << ", \"work_mb\": " << double(r.disk_bytes) / 1048576.0
+        << "},\n  \"timings_ms\": {\"cut\": " << r.tiling.cut_ms
+        << ", \"tiles\": " << r.tiling.tiles_ms
+        << ", \"stitch\": " << r.tiling.stitch_ms << ", \"total\": " << total_ms
+        << "}\n}\n";
+    std::string error;
+    if (!cocone_app::writeText(o.report_file, out.str(), error))
+      fail(error);
+  }
+  return 0;
+}
+
 } // namespace
 
 int
@@ -304,6 +436,51 @@ main(int argc, char** argv)
   if (!o.screenshot_file.empty() && !std::getenv("DISPLAY") &&
       !std::getenv("COCONE_UNDER_XVFB"))
     cocone_app::reexecUnderXvfb(argc, argv);
+
+  // A cloud that does not fit in memory, even in tiles of a million points, is
+  // streamed through files (a binary .ply or .pcd; others are read whole).
+  {
+    std::string why;
+    std::size_t count = 0;
+    std::unique_ptr<pcl::cocone::PointSource> stream =
+        cocone_app::openPointStream(o.input, count, why);
+    if (o.out_of_core && !stream)
+      fail("-out_of_core: " + why);
+    if (stream && (o.out_of_core || o.automatic_tiles)) {
+      const std::size_t budget = o.memory_mb > 0.0
+                                     ? static_cast<std::size_t>(o.memory_mb * 1048576.0)
+                                     : pcl::cocone::availableMemory();
+      const unsigned threads = static_cast<unsigned>(o.threads);
+      bool fits = true, in_memory_fits = true;
+      pcl::cocone::TilingOptions tiling =
+          pcl::cocone::automaticOutOfCoreTiling(count, budget, threads, &fits);
+      pcl::cocone::automaticTiling(count, budget, threads, &in_memory_fits);
+      // In memory while it fits, in tiles if need be (no disk traffic, every output
+      // available); otherwise out of core, unless an output needs the cloud.
+      const bool memory_outputs = cocone_app::extension(o.output) != "ply" ||
+                                  !o.boundary_file.empty() ||
+                                  !o.outliers_file.empty() || !o.normals_file.empty() ||
+                                  !o.screenshot_file.empty() || o.refine_holes;
+      const bool streamed =
+          o.out_of_core || (budget > 0 && !in_memory_fits && !memory_outputs);
+      if (streamed && o.automatic_tiles && !fits)
+        print_warn("Warning: %zu points likely need more than %.0f MB even in tiles of "
+                   "%zu points out of core.\n",
+                   count,
+                   budget / 1048576.0,
+                   tiling.tile_points);
+      if (streamed) {
+        if (!o.automatic_tiles) {
+          tiling.tile_points = o.tile_points;
+          tiling.tiles_in_flight = 0;
+        }
+        if (tiling.tile_points < pcl::cocone::MINIMUM_TILE_POINTS)
+          fail("-out_of_core needs tiles of at least " +
+               std::to_string(pcl::cocone::MINIMUM_TILE_POINTS) + " points");
+        return reconstructOutOfCore(o, *stream, tiling);
+      }
+    }
+  }
 
   pcl::StopWatch total;
   pcl::StopWatch watch;

@@ -9,6 +9,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/io/vtk_lib_io.h>
+#include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone_boundary.h>
 #include <pcl/point_types.h>
 
@@ -753,4 +754,73 @@ TEST_F(Tool, TileSizeFollowsTheMemory)
   EXPECT_NE(run(dir_ + "/auto.pcd " + dir_ + "/bad.ply -tile_points many", &log), 0);
   EXPECT_NE(log.find("is not a number"), std::string::npos) << log;
   EXPECT_FALSE(exists(dir_ + "/bad.ply"));
+}
+
+TEST_F(Tool, OutOfCoreStreamsTheCloudAndTheMesh)
+{
+  // A torus of 20,000 points streamed through tiles on disk: the mesh of the tiles in
+  // memory (the same tiles; the in-memory tool hands the library float offsets, so a
+  // triangle or two may differ), closed, and the work files gone.
+  cocone_test::SampleOptions o;
+  o.n = 20000;
+  o.even = false;
+  const std::vector<Eigen::Vector3d> points = cocone_test::torus(o).points;
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const auto& p : points)
+    cloud.push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+  pcl::io::savePLYFileBinary(dir_ + "/torus.ply", cloud);
+  std::filesystem::create_directory(dir_ + "/work");
+  std::string log;
+  ASSERT_EQ(run(dir_ + "/torus.ply " + dir_ +
+                    "/ooc.ply -out_of_core -tile_points 2500 -threads 2 -work_dir " +
+                    dir_ + "/work -report " + dir_ + "/ooc.json",
+                &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("Out of core: tiles of at most 2500 points"), std::string::npos)
+      << log;
+  EXPECT_TRUE(std::filesystem::is_empty(dir_ + "/work"));
+  pcl::PolygonMesh streamed, tiled;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/ooc.ply", streamed), 0);
+  ASSERT_EQ(run(dir_ + "/torus.ply " + dir_ + "/tiled.ply -tile_points 2500", &log), 0)
+      << log;
+  ASSERT_EQ(pcl::io::loadPLYFile(dir_ + "/tiled.ply", tiled), 0);
+  std::vector<pcl::cocone::Triangle> triangles;
+  for (const auto& p : streamed.polygons) {
+    ASSERT_EQ(p.vertices.size(), 3u);
+    triangles.push_back({int(p.vertices[0]), int(p.vertices[1]), int(p.vertices[2])});
+  }
+  const std::size_t vertices = streamed.cloud.width * streamed.cloud.height;
+  const auto topology = pcl::cocone::analyzeMesh(triangles, vertices);
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.euler, 0);
+  EXPECT_EQ(topology.boundary_edges, 0u);
+  EXPECT_EQ(vertices, points.size());
+  EXPECT_NEAR(double(streamed.polygons.size()), double(tiled.polygons.size()), 2.0);
+  const std::string json = slurpText(dir_ + "/ooc.json");
+  EXPECT_NE(json.find("\"out_of_core\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"boundary_loops\": 0,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"tiles\": {\"count\": 8,"), std::string::npos) << json;
+
+  // What needs the cloud in memory, or a format that cannot be streamed: an error,
+  // no output.
+  EXPECT_NE(run(dir_ + "/torus.ply " + dir_ + "/bad.vtk -out_of_core -tile_points 2500",
+                &log),
+            0);
+  EXPECT_NE(log.find("written as .ply"), std::string::npos) << log;
+  EXPECT_NE(run(dir_ + "/torus.ply " + dir_ +
+                    "/bad.ply -out_of_core -tile_points 2500 "
+                    "-boundary " +
+                    dir_ + "/b.pcd",
+                &log),
+            0);
+  EXPECT_NE(log.find("not available out of core"), std::string::npos) << log;
+  EXPECT_NE(run(dir_ + "/in.xyz " + dir_ + "/bad.ply -out_of_core", &log), 0);
+  EXPECT_NE(log.find("-out_of_core"), std::string::npos) << log;
+  EXPECT_NE(
+      run(dir_ + "/torus.ply " + dir_ + "/bad.ply -out_of_core -tile_points 0", &log),
+      0);
+  EXPECT_NE(log.find("at least 1000"), std::string::npos) << log;
+  EXPECT_FALSE(exists(dir_ + "/bad.ply"));
+  EXPECT_FALSE(exists(dir_ + "/bad.vtk"));
 }
