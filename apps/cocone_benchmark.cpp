@@ -7,7 +7,7 @@
  * method can be faster) and to other reconstruction and border detection methods.
  *
  *   cocone_benchmark generate torus|saddle random|even N OUT.ply [SEED [NOISE]]
- *   cocone_benchmark generate terrain random N OUT.ply [SEED]
+ *   cocone_benchmark generate terrain|torus stream N OUT.ply [SEED]
  *   cocone_benchmark convert CLOUD OUT.ply
  *   cocone_benchmark METHOD CLOUD [--truth auto|closed|saddle|none] [--threads T]
  *   cocone_benchmark tiled CLOUD --tile_points N [--halo S] [--in_flight K]
@@ -15,9 +15,10 @@
  *
  * generate writes seeded samples (area-uniform random or evenly spaced) of the torus
  * R = 1, r = 0.4 or of the monkey saddle over [-1,1]^2, with Gaussian noise of NOISE
- * sample spacings along the normal, or area-uniform random samples of a terrain with
- * walls and holes (Terrain: 7 border loops, Euler characteristic -5), streamed, for
- * clouds larger than the memory; convert writes the finite
+ * sample spacings along the normal; stream writes area-uniform random samples of the
+ * torus or of a terrain with walls and holes (Terrain: 7 border loops, Euler
+ * characteristic -5) as they are drawn, for clouds larger than the memory; convert
+ * writes the finite
  * points of any readable cloud; both as binary PLY of float x, y, z (what the Open3D
  * script reads). METHOD is one of
  *   delaunay             CGAL::Delaunay_triangulation_3 of the points
@@ -86,6 +87,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -564,7 +567,7 @@ usage(const char* program)
 {
   std::fprintf(stderr,
                "usage: %s generate torus|saddle random|even N OUT.ply [SEED [NOISE]]\n"
-               "       %s generate terrain random N OUT.ply [SEED]\n"
+               "       %s generate terrain|torus stream N OUT.ply [SEED]\n"
                "       %s convert CLOUD OUT.ply\n"
                "       %s delaunay|detect|cocone|gp3|boundary_estimation|"
                "advancing_front CLOUD\n"
@@ -637,11 +640,80 @@ struct Terrain {
   }
 };
 
-/** Area-uniform random samples of the Terrain, streamed to a binary PLY. */
-int
-generateTerrain(std::size_t n, std::uint64_t seed, const std::string& path)
+/** Draws one area-uniform random point of a surface from uniform numbers. */
+using Sampler = std::function<Eigen::Vector3d(const std::function<double()>&)>;
+
+/** The Terrain's sampler: rejection from cells drawn in proportion to a bound of the
+ * area element over them (its largest value on a 5 x 5 grid of the cell, with a
+ * margin): the walls are 50 times steeper than the ground, a single bound would
+ * reject 49 of 50. */
+Sampler
+terrainSampler()
 {
-  const Terrain terrain;
+  constexpr int CELLS = 512;
+  const double size = 2.0 / CELLS;
+  const auto terrain = std::make_shared<Terrain>();
+  auto bound = std::make_shared<std::vector<double>>(CELLS * CELLS);
+  auto cumulative = std::make_shared<std::vector<double>>(CELLS * CELLS);
+  double total = 0.0;
+  for (int i = 0; i < CELLS; ++i)
+    for (int j = 0; j < CELLS; ++j) {
+      double b = 0.0;
+      for (int a = 0; a <= 4; ++a)
+        for (int c = 0; c <= 4; ++c)
+          b = std::max(b,
+                       terrain->areaFactor(-1.0 + (i + a / 4.0) * size,
+                                           -1.0 + (j + c / 4.0) * size));
+      (*bound)[i * CELLS + j] = 1.5 * b;
+      (*cumulative)[i * CELLS + j] = total += 1.5 * b;
+    }
+  return [=](const std::function<double()>& uniform) {
+    for (;;) {
+      const auto& cum = *cumulative;
+      const std::size_t c = std::min<std::size_t>(
+          static_cast<std::size_t>(
+              std::upper_bound(cum.begin(), cum.end(), uniform() * total) -
+              cum.begin()),
+          cum.size() - 1);
+      const double x = -1.0 + (static_cast<double>(c / CELLS) + uniform()) * size;
+      const double y = -1.0 + (static_cast<double>(c % CELLS) + uniform()) * size;
+      const double accept = uniform() * (*bound)[c];
+      if (terrain->inHole(x, y))
+        continue;
+      Eigen::Vector2d g;
+      const double z = terrain->height(x, y, g);
+      if (accept < std::sqrt(1.0 + g.squaredNorm()))
+        return Eigen::Vector3d(x, y, z);
+    }
+  };
+}
+
+/** The torus R = 1, r = 0.4 of `generate torus`: the angle round the tube by
+ * rejection on the area element R + r cos(phi). */
+Sampler
+torusSampler()
+{
+  return [](const std::function<double()>& uniform) {
+    constexpr double R = 1.0, r = 0.4, TWO_PI = 6.283185307179586;
+    for (;;) {
+      const double theta = TWO_PI * uniform(), phi = TWO_PI * uniform();
+      if (uniform() * (R + r) >= R + r * std::cos(phi))
+        continue;
+      const double ring = R + r * std::cos(phi);
+      return Eigen::Vector3d(
+          ring * std::cos(theta), ring * std::sin(theta), r * std::sin(phi));
+    }
+  };
+}
+
+/** \a n area-uniform random samples of a surface streamed to a binary PLY of float
+ * x, y, z: clouds larger than the memory, without the test samples' truth. */
+int
+generateStreamed(const Sampler& sample,
+                 std::size_t n,
+                 std::uint64_t seed,
+                 const std::string& path)
+{
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) {
     std::fprintf(stderr, "cannot write %s\n", path.c_str());
@@ -652,50 +724,17 @@ generateTerrain(std::size_t n, std::uint64_t seed, const std::string& path)
                "property float x\nproperty float y\nproperty float z\nend_header\n",
                n);
   std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 1;
-  const auto uniform = [&state] { // splitmix64
+  const std::function<double()> uniform = [&state] { // splitmix64
     std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
   };
-  // Rejection from cells drawn in proportion to a bound of the area element over
-  // them (its largest value on a 5 x 5 grid of the cell, with a margin): the walls
-  // are 50 times steeper than the ground, a single bound would reject 49 of 50.
-  constexpr int CELLS = 512;
-  const double size = 2.0 / CELLS;
-  std::vector<double> bound(CELLS * CELLS), cumulative(CELLS * CELLS);
-  double total = 0.0;
-  for (int i = 0; i < CELLS; ++i)
-    for (int j = 0; j < CELLS; ++j) {
-      double b = 0.0;
-      for (int a = 0; a <= 4; ++a)
-        for (int c = 0; c <= 4; ++c)
-          b = std::max(b,
-                       terrain.areaFactor(-1.0 + (i + a / 4.0) * size,
-                                          -1.0 + (j + c / 4.0) * size));
-      bound[i * CELLS + j] = 1.5 * b;
-      cumulative[i * CELLS + j] = total += 1.5 * b;
-    }
   std::vector<float> block;
   bool ok = true;
   for (std::size_t i = 0; i < n && ok; ++i) {
-    for (;;) {
-      const std::size_t cell = static_cast<std::size_t>(
-          std::upper_bound(cumulative.begin(), cumulative.end(), uniform() * total) -
-          cumulative.begin());
-      const std::size_t c = std::min<std::size_t>(cell, cumulative.size() - 1);
-      const double x = -1.0 + (static_cast<double>(c / CELLS) + uniform()) * size;
-      const double y = -1.0 + (static_cast<double>(c % CELLS) + uniform()) * size;
-      const double accept = uniform() * bound[c];
-      if (terrain.inHole(x, y))
-        continue;
-      Eigen::Vector2d g;
-      const double z = terrain.height(x, y, g);
-      if (accept >= std::sqrt(1.0 + g.squaredNorm()))
-        continue;
-      block.insert(block.end(), {float(x), float(y), float(z)});
-      break;
-    }
+    const Eigen::Vector3d p = sample(uniform);
+    block.insert(block.end(), {float(p.x()), float(p.y()), float(p.z())});
     if (block.size() >= 3 * 65536 || i + 1 == n) {
       ok = std::fwrite(block.data(), sizeof(float), block.size(), f) == block.size();
       block.clear();
@@ -719,8 +758,9 @@ generate(int argc, char** argv)
   o.seed = argc > 6 ? std::strtoull(argv[6], nullptr, 10) : 1;
   o.noise = argc > 7 ? std::strtod(argv[7], nullptr) : 0.0;
   o.even = sampling == "even";
-  if (surface == "terrain" && sampling == "random" && o.noise == 0.0)
-    return generateTerrain(o.n, o.seed, argv[5]);
+  if (sampling == "stream" && (surface == "terrain" || surface == "torus"))
+    return generateStreamed(
+        surface == "terrain" ? terrainSampler() : torusSampler(), o.n, o.seed, argv[5]);
   if ((surface != "torus" && surface != "saddle") ||
       (sampling != "even" && sampling != "random"))
     return usage(argv[0]);

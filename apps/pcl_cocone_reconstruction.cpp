@@ -11,6 +11,7 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/triangulation.h>
 #include <pcl/surface/cocone_boundary.h>
 #include <pcl/point_types.h>
 
@@ -337,7 +338,9 @@ reconstructOutOfCore(const Options& o,
   p.threads = static_cast<unsigned>(o.threads);
   print_info("Out of core: tiles of at most %zu points, %u at a time, files in %s.\n",
              tiling.tile_points,
-             tiling.tiles_in_flight,
+             tiling.tiles_in_flight > 0
+                 ? tiling.tiles_in_flight
+                 : static_cast<unsigned>(pcl::cocone::resolveThreads(p.threads)),
              directory.c_str());
   pcl::StopWatch total;
   cocone_app::PlyMeshWriter writer(o.output);

@@ -43,7 +43,7 @@ constexpr std::size_t POINTS = 30000;
 /** 16 tiles of about 1,900 points from 30,000. */
 constexpr std::size_t TILE_POINTS = 3000;
 /** The share of triangles that may differ from one piece, in percent. Measured on
- * these clouds: 0.007 (torus), 0.018 (sphere with holes), 0.06 (noisy torus), 0.13
+ * these clouds: 0.007 (torus), 0.027 (sphere with holes), 0.06 (noisy torus), 0.155
  * (saddle with a hole: at the sampled surface's border, whose labels depend on
  * points far along it, see runTiled()); 0.02 to 2.8 before the walk chose the side
  * of flat tetrahedra by the points alone. */

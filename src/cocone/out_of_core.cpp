@@ -223,7 +223,7 @@ struct Labels {
 
 /** The tile's files in the work directory. */
 struct TileFiles {
-  fs::path core, halo, labels, triangles;
+  fs::path core, halo, labels, triangles, patches;
 };
 
 void
@@ -321,7 +321,8 @@ public:
     return {path_ / (stem + ".core"),
             path_ / (stem + ".halo"),
             path_ / (stem + ".labels"),
-            path_ / (stem + ".triangles")};
+            path_ / (stem + ".triangles"),
+            path_ / (stem + ".patches")};
   }
 
   /** Bytes the directory holds now. */
@@ -759,13 +760,55 @@ private:
   }
 
   /** Tile \a t's patches (the components of its kept triangles), numbered from
-   * \a first. */
-  static std::vector<int>
-  patchesOf(const std::vector<Triangle>& kept, int first, std::size_t& count)
+   * its first; the border half-edges of its triangles outside the band (among
+   * those) go to outside_halves_. The triangles are renumbered densely first, the
+   * core's vertices and then the few beyond it, as the incidences' tables are as
+   * long as the largest vertex number (the whole cloud's: 64 tiles of 100M points
+   * took minutes). */
+  std::vector<int>
+  tilePatches(std::size_t t, const std::vector<Triangle>& kept, std::size_t& count)
   {
-    std::vector<int> patch = triangleComponents(kept, &count);
+    const int lo = static_cast<int>(tile_vertex_begin_[t]),
+              hi = static_cast<int>(tile_vertex_begin_[t + 1]);
+    std::vector<int> beyond;
+    for (const Triangle& v : kept)
+      for (const int x : v)
+        if (x < lo || x >= hi)
+          beyond.push_back(x);
+    std::sort(beyond.begin(), beyond.end());
+    beyond.erase(std::unique(beyond.begin(), beyond.end()), beyond.end());
+    const auto dense = [&](int x) {
+      return x >= lo && x < hi
+                 ? x - lo
+                 : hi - lo +
+                       static_cast<int>(
+                           std::lower_bound(beyond.begin(), beyond.end(), x) -
+                           beyond.begin());
+    };
+    const auto global = [&](int x) {
+      return x < hi - lo ? x + lo : beyond[static_cast<std::size_t>(x - (hi - lo))];
+    };
+    std::vector<Triangle> renumbered(kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        renumbered[i][k] = dense(kept[i][k]);
+    const EdgeIncidences inc(renumbered, threads_);
+    std::vector<int> patch = triangleComponents(inc, kept.size(), &count);
     for (int& p : patch)
-      p += first;
+      p += static_cast<int>(patch_begin_[t]);
+    for (std::size_t e = 0; e < inc.edges.size(); ++e) {
+      std::size_t outside = 0, last = 0;
+      for (std::size_t i = inc.first[e]; i < inc.first[e + 1]; ++i)
+        if (!inBand(kept[inc.triangle[i]])) {
+          ++outside;
+          last = i;
+        }
+      if (outside == 1)
+        outside_halves_.push_back({global(inc.edges[e][0]),
+                                   global(inc.edges[e][1]),
+                                   inc.forward[last],
+                                   patch[inc.triangle[last]]});
+    }
     return patch;
   }
 
@@ -780,9 +823,13 @@ private:
     for (std::size_t t = 0; t < count_; ++t) {
       mapped(t, kept, &seen);
       std::size_t patches = 0;
-      const std::vector<int> patch =
-          patchesOf(kept, static_cast<int>(patch_begin_[t]), patches);
+      const std::vector<int> patch = tilePatches(t, kept, patches);
       patch_begin_[t + 1] = patch_begin_[t] + patches;
+      {
+        Writer w; // for write()
+        w.vector(patch);
+        append(work_.tile(t).patches, w.bytes.data(), w.bytes.size());
+      }
       sums_.resize(patch_begin_[t + 1]);
       const Labels l = readLabels(work_.tile(t));
       const auto at = [&](int v) -> Eigen::Vector3d {
@@ -993,14 +1040,15 @@ private:
           fwd ? half(a, b) : half(b, a);
         }
     }
+    for (const auto& h : outside_halves_) // as the triangle runs it, once turned
+      (h[2] != 0) != (face_[h[3]] != 0) ? half(h[0], h[1]) : half(h[1], h[0]);
+    std::vector<std::array<int, 4>>().swap(outside_halves_);
     std::vector<Triangle> kept, out;
     std::vector<Eigen::Vector3d> positions, normals;
     for (std::size_t t = 0; t < count_; ++t) {
       const Labels l = readLabels(work_.tile(t));
       mapped(t, kept);
-      std::size_t patches = 0;
-      const std::vector<int> patch =
-          patchesOf(kept, static_cast<int>(patch_begin_[t]), patches);
+      const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
       const std::size_t lo = tile_vertex_begin_[t];
       std::vector<Eigen::Vector3d> facing(tile_vertex_begin_[t + 1] - lo,
                                           Eigen::Vector3d::Zero());
@@ -1018,15 +1066,6 @@ private:
         const Eigen::Vector3d a = (at(v[1]) - at(v[0])).cross(at(v[2]) - at(v[0]));
         for (const int x : v)
           facing[static_cast<std::size_t>(x) - lo] += a;
-      }
-      {
-        const EdgeIncidences inc(out);
-        for (std::size_t e = 0; e < inc.edges.size(); ++e)
-          if (inc.count(e) == 1) {
-            const bool fwd = inc.forward[inc.first[e]];
-            const int a = inc.edges[e][0], b = inc.edges[e][1];
-            fwd ? half(a, b) : half(b, a);
-          }
       }
       // The vertices of the tile, with their normals against the stitched mesh.
       positions.clear();
@@ -1056,9 +1095,7 @@ private:
     // The triangles: each tile's outside the band, then the band's.
     for (std::size_t t = 0; t < count_; ++t) {
       mapped(t, kept);
-      std::size_t patches = 0;
-      const std::vector<int> patch =
-          patchesOf(kept, static_cast<int>(patch_begin_[t]), patches);
+      const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
       out.clear();
       for (std::size_t i = 0; i < kept.size(); ++i) {
         Triangle v = kept[i];
@@ -1151,6 +1188,9 @@ private:
   std::vector<std::size_t> patch_begin_;
   std::vector<VolumeSums> sums_; ///< per patch, its triangles outside the band
   std::size_t outside_ = 0;      ///< triangles outside the band
+  /** Border half-edges among the triangles outside the band: low, high vertex,
+   * whether its triangle runs low to high before its patch is turned, the patch. */
+  std::vector<std::array<int, 4>> outside_halves_;
   std::vector<std::uint8_t> turn_, face_;
   std::vector<int> band_vertex_; ///< the band's vertices, ascending
   std::vector<Eigen::Vector3d> band_positions_;

@@ -316,8 +316,9 @@ stitchTiles(TilePlan plan,
  *
  * The finite points are cut into tiles by recursive median splits along the longest
  * axis of the points' box (exact duplicates stay together), so that each core holds
- * at most TilingOptions::tile_points points and every point is in exactly one core.
- * A tile is its core plus the halo: the other points within TilingOptions::
+ * at most TilingOptions::tile_points points and every point is in exactly one core,
+ * in the order of the points (runOutOfCore() cuts the same way, from files). A tile
+ * is its core plus the halo: the other points within TilingOptions::
  * halo_spacings local spacings of the core's box. run() reconstructs each tile on
  * its own, with the caller's ids. The three phases are planTiles(), reconstructTile()
  * per tile and stitchTiles(); runTiled() is them, in one process.
