@@ -350,14 +350,17 @@ reconstructOutOfCore(const Options& o,
     fail(r.error);
   written.push_back(o.output);
   const double total_ms = total.getTime();
-  print_info("%zu points in %zu tiles (%zu halo points): %zu triangles, %zu border "
-             "loops, %zu undersampled points, %zu undersampled holes closed; cut %.0f "
+  print_info("%zu points in %zu tiles (%zu halo points): %zu triangles, %zu "
+             "components, Euler characteristic %ld, %zu border loops, %zu undersampled "
+             "points, %zu undersampled holes closed; cut %.0f "
              "ms, tiles %.0f ms, stitch and write %.0f ms; work files at most %.0f "
              "MB.\n",
              r.points,
              r.tiling.tiles,
              r.tiling.halo_points,
              r.triangles,
+             r.components,
+             r.euler,
              r.border_loops.size(),
              r.boundary_indices.size(),
              r.holes_filled,
@@ -401,6 +404,7 @@ reconstructOutOfCore(const Options& o,
         << ",\n  \"holes_filled\": " << r.holes_filled
         << ",\n  \"hole_triangles\": " << r.counts.hole_triangles
         << ",\n  \"added_points\": 0,\n  \"triangles\": " << r.triangles
+        << ",\n  \"components\": " << r.components << ",\n  \"euler\": " << r.euler
         << ",\n  \"boundary_loops\": " << r.border_loops.size()
         << ",\n  \"boundary_indices\": " << jsonList(r.boundary_indices)
         << ",\n  \"border_indices\": " << jsonList(border)

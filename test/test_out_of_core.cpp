@@ -245,6 +245,8 @@ TEST_P(OutOfCore, SameMeshAsTheInMemoryTiling)
   EXPECT_EQ(r.holes_filled, tiled.filled_holes.size());
   EXPECT_EQ(r.tiling.patches_flipped, report.patches_flipped);
   EXPECT_EQ(topology.euler, s.euler);
+  EXPECT_EQ(r.euler, topology.euler);
+  EXPECT_EQ(r.components, topology.components);
   EXPECT_EQ(static_cast<int>(r.border_loops.size()), s.boundary_loops);
   EXPECT_EQ(topology.nonmanifold_edges, 0u);
   EXPECT_EQ(topology.nonmanifold_vertices, 0u);
@@ -280,6 +282,8 @@ TEST_P(OutOfCore, CutOnASampleGivesTheTopologyOfOnePiece)
   EXPECT_GE(r.tiling.tiles, 8u);
   EXPECT_LE(r.tiling.tiles, 32u);
   EXPECT_EQ(topology.euler, s.euler);
+  EXPECT_EQ(r.euler, topology.euler);
+  EXPECT_EQ(r.components, 1u);
   EXPECT_EQ(static_cast<int>(r.border_loops.size()), s.boundary_loops);
   EXPECT_EQ(topology.nonmanifold_edges + topology.nonmanifold_vertices +
                 topology.orientation_conflicts,

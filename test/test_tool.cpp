@@ -800,6 +800,8 @@ TEST_F(Tool, OutOfCoreStreamsTheCloudAndTheMesh)
   const std::string json = slurpText(dir_ + "/ooc.json");
   EXPECT_NE(json.find("\"out_of_core\": true"), std::string::npos) << json;
   EXPECT_NE(json.find("\"boundary_loops\": 0,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"components\": 1,\n  \"euler\": 0,"), std::string::npos)
+      << json;
   EXPECT_NE(json.find("\"tiles\": {\"count\": 8,"), std::string::npos) << json;
 
   // What needs the cloud in memory, or a format that cannot be streamed: an error,

@@ -1003,6 +1003,12 @@ private:
                  : loose[band_component_[i]].negative())
         std::swap(band_[i][1], band_[i][2]);
     }
+    // The components: the sets of patches with a triangle, and the band's pieces of
+    // none.
+    for (std::size_t p = 0; p < patches; ++p)
+      report_.components += total[p].triangles > 0.0; // a root with triangles
+    for (std::size_t c = 0; c < components; ++c)
+      report_.components += anchor[c] < 0;
   }
 
   // ---- The output ----------------------------------------------------------------
@@ -1093,6 +1099,7 @@ private:
         throw IoError(error);
     }
     // The triangles: each tile's outside the band, then the band's.
+    std::vector<std::uint8_t> used(nv_, 0); // for the Euler characteristic
     for (std::size_t t = 0; t < count_; ++t) {
       mapped(t, kept);
       const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
@@ -1104,6 +1111,8 @@ private:
         if (face_[patch[i]])
           std::swap(v[1], v[2]);
         out.push_back(v);
+        for (const int x : v)
+          used[x] = 1;
         if (out.size() == SINK_TRIANGLES) {
           if (!sink_.addTriangles(out, error))
             throw IoError(error);
@@ -1114,18 +1123,26 @@ private:
         throw IoError(error);
     }
     out.clear();
-    for (const Triangle& v : band_)
+    for (const Triangle& v : band_) {
       out.push_back({band_vertex_[v[0]], band_vertex_[v[1]], band_vertex_[v[2]]});
+      for (const int x : out.back())
+        used[x] = 1;
+    }
     if (!out.empty() && !sink_.addTriangles(out, error))
       throw IoError(error);
     if (!sink_.end(error))
       throw IoError(error);
-    loops(std::move(halves));
+    const std::size_t border_edges = loops(std::move(halves));
+    const auto vertices = static_cast<long>(std::count(used.begin(), used.end(), 1));
+    const auto faces = static_cast<long>(total);
+    report_.euler =
+        vertices - (3 * faces + static_cast<long>(border_edges)) / 2 + faces;
   }
 
   /** The border loops from the border half-edges of the band and of the rest (an
-   * edge of the band's cut edge is a border half-edge of both, and is none). */
-  void
+   * edge of the band's cut edge is a border half-edge of both, and is none); returns
+   * the number of border edges. */
+  std::size_t
   loops(std::vector<std::array<int, 3>> halves)
   {
     std::sort(halves.begin(), halves.end());
@@ -1160,6 +1177,7 @@ private:
       report_.border_loops.push_back(std::move(loop));
     }
     detail::sortLoops(report_.border_loops);
+    return next.size();
   }
 
   static constexpr std::uint8_t V0 = 1, V1 = 2;

@@ -97,6 +97,11 @@ struct OutOfCoreResult {
   std::size_t vertices = 0;
   /** Triangles written. */
   std::size_t triangles = 0;
+  /** The mesh's Euler characteristic V - E + F (V: the vertices in a triangle). */
+  long euler = 0;
+  /** The mesh's components: pieces of triangles joined through edges (a piece the
+   * stitch's repair cut in two at a seam still counts once). */
+  std::size_t components = 0;
   /** The mesh's border loops over ids (each starting at its lowest id). */
   std::vector<std::vector<int>> border_loops;
   /** Ids labelled boundary (as Result::boundary_indices), ascending. */
