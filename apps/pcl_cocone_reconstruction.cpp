@@ -105,7 +105,7 @@ printHelp(const char* name)
       "                    fit in memory even in tiles; no\n"
       "                    -boundary, -outliers, -normals, -screenshot, -refine_holes\n"
       "  -work_dir DIR     where an out-of-core run keeps its files (default: the\n"
-      "                    output's directory; about 70 bytes per point)\n"
+      "                    output's directory; about 100 bytes per point)\n"
       "  -boundary FILE    write the undersampled points as a .pcd with their input\n"
       "                    index in the field 'index'\n"
       "  -outliers FILE    write the outliers (in no triangle) as a .pcd with their\n"

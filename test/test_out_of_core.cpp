@@ -367,3 +367,40 @@ TEST(OutOfCoreInput, FailuresGiveAnErrorAndLeaveNoFile)
 }
 
 } // namespace
+
+namespace {
+
+TEST(OutOfCoreTiling, TilesFitTheMemoryBesideTheCloud)
+{
+  using pcl::cocone::automaticOutOfCoreTiling;
+  const std::size_t gb = std::size_t{1} << 30;
+  bool fits = false;
+  // 100M points in 8 GB with 2 threads: 2.4 GB for the cloud, two tiles of 1.6M
+  // points (1,625 bytes per core point with its halo) in the rest.
+  TilingOptions t = automaticOutOfCoreTiling(100000000, 8 * gb, 2, &fits);
+  EXPECT_TRUE(fits);
+  EXPECT_EQ(t.tile_points, 1600000u);
+  EXPECT_EQ(t.tiles_in_flight, 2u);
+  EXPECT_LE(100000000.0 * pcl::cocone::OUT_OF_CORE_BYTES_PER_POINT +
+                t.tiles_in_flight * 1.25 * pcl::cocone::ONE_PIECE_BYTES_PER_POINT *
+                    double(t.tile_points),
+            8.0 * double(gb));
+  // Room for one tile of the smallest size, not two: one in flight.
+  const std::size_t one = 1000 * 24 + 1625 * 1500;
+  t = automaticOutOfCoreTiling(1000, one, 2, &fits);
+  EXPECT_TRUE(fits);
+  EXPECT_EQ(t.tiles_in_flight, 1u);
+  EXPECT_EQ(t.tile_points, 1250u);
+  // Not even that: the smallest tiles, one at a time, and a warning flag.
+  t = automaticOutOfCoreTiling(100000000, gb, 2, &fits);
+  EXPECT_FALSE(fits);
+  EXPECT_EQ(t.tile_points, pcl::cocone::MINIMUM_TILE_POINTS);
+  EXPECT_EQ(t.tiles_in_flight, 1u);
+  // Unknown memory: tiles of a million points, one per thread.
+  t = automaticOutOfCoreTiling(100000000, 0, 2, &fits);
+  EXPECT_TRUE(fits);
+  EXPECT_EQ(t.tile_points, 1000000u);
+  EXPECT_EQ(t.tiles_in_flight, 2u);
+}
+
+} // namespace

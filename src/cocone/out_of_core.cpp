@@ -436,6 +436,7 @@ public:
     labels();
     seams();
     band();
+    report_.disk_bytes = std::max(report_.disk_bytes, work_.bytes()); // at its most
     orientComponents();
     write();
     report_.tiling.stitch_ms = clock.lap();
@@ -948,8 +949,12 @@ private:
         P,
         triangles,
         [&](const Triangle& t) {
-          if (!inner[t[0]] || !inner[t[1]] || !inner[t[2]])
-            return false; // across the band's cut edge
+          // The band's cut edge runs between vertices outside V1 (the edges at a V1
+          // vertex have their whole stars): a patch across it would cover the
+          // triangles beyond, which are not in the band.
+          if ((!inner[t[0]] && !inner[t[1]]) || (!inner[t[1]] && !inner[t[2]]) ||
+              (!inner[t[0]] && !inner[t[2]]))
+            return false;
           return std::binary_search(seen.begin(), seen.end(), t) ||
                  (border(t[0], t[1]) && border(t[1], t[2]) && border(t[0], t[2]) &&
                   (core_of(t[0]) != core_of(t[1]) || core_of(t[0]) != core_of(t[2])));
@@ -1229,6 +1234,12 @@ automaticOutOfCoreTiling(std::size_t points,
     *fits = true;
   const unsigned int workers =
       threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+  if (memory == 0) { // unknown: tiles of a million points, a gigabyte or two each
+    TilingOptions tiling;
+    tiling.tile_points = 1000000;
+    tiling.tiles_in_flight = workers;
+    return tiling;
+  }
   const double room = static_cast<double>(memory) -
                       static_cast<double>(points) * OUT_OF_CORE_BYTES_PER_POINT;
   TilingOptions tiling;

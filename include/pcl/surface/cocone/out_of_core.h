@@ -30,7 +30,8 @@ constexpr std::size_t OUT_OF_CORE_BYTES_PER_POINT = 24;
  * bytes: as many tiles in flight as \a threads (0: one per processor), each the
  * largest, rounded down as automaticTilePoints() rounds, that fits beside
  * OUT_OF_CORE_BYTES_PER_POINT per point; one tile in flight if not even
- * MINIMUM_TILE_POINTS fit so (\a fits is then false when one does not fit either). */
+ * MINIMUM_TILE_POINTS fit so (\a fits is then false when one does not fit either).
+ * \a memory 0 (unknown): tiles of a million points. */
 TilingOptions
 automaticOutOfCoreTiling(std::size_t points,
                          std::size_t memory,
@@ -120,8 +121,8 @@ struct OutOfCoreResult {
   ReconstructionCounts counts;
   /** What the tiling did (point_tile and triangle_tile are left empty). */
   TilingReport tiling;
-  /** The most bytes the work directory held (measured after the cut and after the
-   * tiles). */
+  /** The most bytes the work directory held (measured after the cut and when the
+   * stitch has read the tiles' results: about 33 and 100 bytes per point). */
   std::size_t disk_bytes = 0;
 };
 
@@ -143,9 +144,9 @@ struct OutOfCoreResult {
  * (5) the vertices, tile after tile, and the triangles go to \a sink.
  *
  * Memory: one tile in flight (ONE_PIECE_BYTES_PER_POINT per point of core and
- * halo) per TilingOptions::tiles_in_flight, the stitch's band, and 9 bytes per
- * point of the cloud (its tile, its vertex number, its flags). Disk: about 70 bytes
- * per point in \a directory, removed on return.
+ * halo) per TilingOptions::tiles_in_flight, the stitch's band, and
+ * OUT_OF_CORE_BYTES_PER_POINT. Disk: about 100 bytes per point in \a directory (the
+ * tiles' results), removed on return.
  *
  * What differs from runTiled() on the same tiles: the vertices are numbered tile
  * after tile (core order), not in input order, and the triangles come in that order;
