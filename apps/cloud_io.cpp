@@ -77,13 +77,12 @@ fileSize(const std::string& path)
   return f ? static_cast<std::size_t>(f.tellg()) : 0;
 }
 
-/** A PCD header PCL's reader can be trusted with: consistent FIELDS, SIZE, TYPE and
- * COUNT, a known DATA kind, and no more points than the file can hold (compressed
- * data shrinks by less than 100 times). */
-bool
-checkPcdHeader(const std::string& path, std::string& error)
+} // namespace
+
+const std::set<std::string>&
+pcdHeaderKeys()
 {
-  static const std::set<std::string> KEYS{"VERSION",
+  static const std::set<std::string> keys{"VERSION",
                                           "FIELDS",
                                           "COLUMNS",
                                           "SIZE",
@@ -94,6 +93,18 @@ checkPcdHeader(const std::string& path, std::string& error)
                                           "VIEWPOINT",
                                           "POINTS",
                                           "DATA"};
+  return keys;
+}
+
+namespace {
+
+/** A PCD header PCL's reader can be trusted with: consistent FIELDS, SIZE, TYPE and
+ * COUNT, a known DATA kind, and no more points than the file can hold (compressed
+ * data shrinks by less than 100 times). */
+bool
+checkPcdHeader(const std::string& path, std::string& error)
+{
+  const std::set<std::string>& KEYS = pcdHeaderKeys();
   std::ifstream in(path, std::ios::binary);
   std::vector<std::string> fields, sizes, types, counts;
   std::size_t width = 0, height = 1, points = 0;

@@ -14,10 +14,15 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace cocone_app {
+
+/** The keywords a PCD header may hold (the ones PCL writes and reads). */
+const std::set<std::string>&
+pcdHeaderKeys();
 
 /** Lower-case extension of a path, without the dot ("" if none). */
 std::string

@@ -338,17 +338,7 @@ readPlyHeader(std::FILE* file, std::uint64_t file_size, Layout& l, std::string& 
 bool
 readPcdHeader(std::FILE* file, Layout& l, std::string& why)
 {
-  static const std::set<std::string> KEYS{"VERSION",
-                                          "FIELDS",
-                                          "COLUMNS",
-                                          "SIZE",
-                                          "TYPE",
-                                          "COUNT",
-                                          "WIDTH",
-                                          "HEIGHT",
-                                          "VIEWPOINT",
-                                          "POINTS",
-                                          "DATA"};
+  const std::set<std::string>& KEYS = pcdHeaderKeys();
   std::vector<std::string> fields, sizes, types, counts, w;
   std::size_t width = 0, height = 1, points = 0;
   bool have_width = false, have_points = false;

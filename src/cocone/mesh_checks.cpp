@@ -5,6 +5,7 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
+#include "disjoint_sets.h"
 #include "edge_sort.h"
 
 #include <algorithm>
@@ -14,41 +15,7 @@
 namespace pcl {
 namespace cocone {
 
-namespace {
-
-/** Union-find with path halving. */
-struct DisjointSets {
-  std::vector<int> parent;
-
-  explicit DisjointSets(std::size_t n = 0) { reset(n); }
-
-  /** n singletons again, reusing the storage. */
-  void
-  reset(std::size_t n)
-  {
-    parent.resize(n);
-    std::iota(parent.begin(), parent.end(), 0);
-  }
-
-  int
-  find(int x)
-  {
-    while (parent[x] != x)
-      x = parent[x] = parent[parent[x]];
-    return x;
-  }
-
-  void
-  unite(int a, int b)
-  {
-    a = find(a);
-    b = find(b);
-    if (a != b)
-      parent[std::max(a, b)] = std::min(a, b);
-  }
-};
-
-} // namespace
+using detail::DisjointSets;
 
 EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented, int threads)
 {

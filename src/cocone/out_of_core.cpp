@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "caller_ids.h"
+#include "disjoint_sets.h"
 #include "parallel.h"
 #include "stopwatch.h"
 #include "tiles.h"
@@ -45,8 +46,6 @@ namespace fs = std::filesystem;
 constexpr std::size_t CHUNK_POINTS = std::size_t{1} << 16;
 /** Bytes a tile's file buffers in memory before they are appended to it. */
 constexpr std::size_t FILE_BUFFER = std::size_t{1} << 16;
-/** Triangles handed to the sink at a time. */
-constexpr std::size_t SINK_TRIANGLES = std::size_t{1} << 16;
 
 /** An I/O failure: caught at the top, its message the run's error. */
 struct IoError : std::runtime_error {
@@ -375,36 +374,6 @@ struct VolumeSums {
     const Eigen::Vector3d centre = corners / (3.0 * triangles);
     return S - centre.dot(N) < 0.0;
   }
-};
-
-/** Union-find over patches. */
-class Sets {
-public:
-  explicit Sets(std::size_t n) : up_(n)
-  {
-    for (std::size_t i = 0; i < n; ++i)
-      up_[i] = static_cast<int>(i);
-  }
-
-  int
-  find(int x)
-  {
-    while (up_[x] != x)
-      x = up_[x] = up_[up_[x]];
-    return x;
-  }
-
-  void
-  unite(int a, int b)
-  {
-    a = find(a);
-    b = find(b);
-    if (a != b)
-      up_[std::max(a, b)] = std::min(a, b);
-  }
-
-private:
-  std::vector<int> up_;
 };
 
 class OutOfCore {
@@ -972,7 +941,7 @@ private:
   orientComponents()
   {
     const std::size_t patches = patch_begin_[count_];
-    Sets sets(patches);
+    detail::DisjointSets sets(patches);
     std::size_t components = 0;
     band_component_ = triangleComponents(band_, &components);
     std::vector<int> anchor(components, -1);
@@ -1018,6 +987,26 @@ private:
 
   // ---- The output ----------------------------------------------------------------
 
+  /** Tile \a t's kept triangles outside the band, each turned as its patch faces. */
+  std::vector<Triangle>
+  outsideTriangles(std::size_t t) const
+  {
+    std::vector<Triangle> kept;
+    mapped(t, kept);
+    const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
+    std::vector<Triangle> out;
+    out.reserve(kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      Triangle v = kept[i];
+      if (inBand(v))
+        continue;
+      if (face_[patch[i]])
+        std::swap(v[1], v[2]);
+      out.push_back(v);
+    }
+    return out;
+  }
+
   void
   write()
   {
@@ -1054,29 +1043,31 @@ private:
     for (const auto& h : outside_halves_) // as the triangle runs it, once turned
       (h[2] != 0) != (face_[h[3]] != 0) ? half(h[0], h[1]) : half(h[1], h[0]);
     std::vector<std::array<int, 4>>().swap(outside_halves_);
-    std::vector<Triangle> kept, out;
+    // The band's vertices in a triangle, for the Euler characteristic.
+    std::vector<int> band_used;
+    for (const Triangle& v : band_)
+      for (const int x : v)
+        band_used.push_back(band_vertex_[x]);
+    std::sort(band_used.begin(), band_used.end());
+    band_used.erase(std::unique(band_used.begin(), band_used.end()), band_used.end());
+    std::size_t used = band_used.size();
     std::vector<Eigen::Vector3d> positions, normals;
     for (std::size_t t = 0; t < count_; ++t) {
       const Labels l = readLabels(work_.tile(t));
-      mapped(t, kept);
-      const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
+      const std::vector<Triangle> out = outsideTriangles(t);
       const std::size_t lo = tile_vertex_begin_[t];
       std::vector<Eigen::Vector3d> facing(tile_vertex_begin_[t + 1] - lo,
                                           Eigen::Vector3d::Zero());
-      out.clear();
-      for (std::size_t i = 0; i < kept.size(); ++i) {
-        Triangle v = kept[i];
-        if (inBand(v))
-          continue;
-        if (face_[patch[i]])
-          std::swap(v[1], v[2]);
-        out.push_back(v);
+      std::vector<std::uint8_t> in_triangle(facing.size(), 0); // and not in the band's
+      for (const Triangle& v : out) {
         const auto at = [&](int x) -> const Eigen::Vector3d& {
           return l.position[static_cast<std::size_t>(x) - lo];
         };
         const Eigen::Vector3d a = (at(v[1]) - at(v[0])).cross(at(v[2]) - at(v[0]));
-        for (const int x : v)
+        for (const int x : v) {
           facing[static_cast<std::size_t>(x) - lo] += a;
+          in_triangle[static_cast<std::size_t>(x) - lo] = 1;
+        }
       }
       // The vertices of the tile, with their normals against the stitched mesh.
       positions.clear();
@@ -1091,6 +1082,8 @@ private:
         const auto b = std::lower_bound(band_vertex_.begin(), band_vertex_.end(), v);
         if (b != band_vertex_.end() && *b == v)
           f += band_facing[static_cast<std::size_t>(b - band_vertex_.begin())];
+        used += in_triangle[k] &&
+                !std::binary_search(band_used.begin(), band_used.end(), v);
         Eigen::Vector3d normal = l.normal[k];
         detail::turnNormal(normal, f, (l.flags[i] & 3) != 0);
         positions.push_back(l.position[k]);
@@ -1104,41 +1097,18 @@ private:
         throw IoError(error);
     }
     // The triangles: each tile's outside the band, then the band's.
-    std::vector<std::uint8_t> used(nv_, 0); // for the Euler characteristic
-    for (std::size_t t = 0; t < count_; ++t) {
-      mapped(t, kept);
-      const std::vector<int> patch = Reader(slurp(work_.tile(t).patches)).vector<int>();
-      out.clear();
-      for (std::size_t i = 0; i < kept.size(); ++i) {
-        Triangle v = kept[i];
-        if (inBand(v))
-          continue;
-        if (face_[patch[i]])
-          std::swap(v[1], v[2]);
-        out.push_back(v);
-        for (const int x : v)
-          used[x] = 1;
-        if (out.size() == SINK_TRIANGLES) {
-          if (!sink_.addTriangles(out, error))
-            throw IoError(error);
-          out.clear();
-        }
-      }
-      if (!out.empty() && !sink_.addTriangles(out, error))
+    for (std::size_t t = 0; t < count_; ++t)
+      if (!sink_.addTriangles(outsideTriangles(t), error))
         throw IoError(error);
-    }
-    out.clear();
-    for (const Triangle& v : band_) {
+    std::vector<Triangle> out;
+    for (const Triangle& v : band_)
       out.push_back({band_vertex_[v[0]], band_vertex_[v[1]], band_vertex_[v[2]]});
-      for (const int x : out.back())
-        used[x] = 1;
-    }
     if (!out.empty() && !sink_.addTriangles(out, error))
       throw IoError(error);
     if (!sink_.end(error))
       throw IoError(error);
     const std::size_t border_edges = loops(std::move(halves));
-    const auto vertices = static_cast<long>(std::count(used.begin(), used.end(), 1));
+    const auto vertices = static_cast<long>(used);
     const auto faces = static_cast<long>(total);
     report_.euler =
         vertices - (3 * faces + static_cast<long>(border_edges)) / 2 + faces;
