@@ -20,6 +20,7 @@
 #include <support/surfaces.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -1406,4 +1407,62 @@ TEST(HoleFilling, CoarseTubeComesOutClosed)
     // The labels stay the flatness test's (the paper's output).
     EXPECT_EQ(r.boundary_indices, open.boundary_indices);
   }
+}
+
+TEST(Reconstruction, HolesInRollingGroundStayOpen)
+{
+  // Random samples of rolling ground (a height field, slopes under 6 degrees) with
+  // six round holes 10 to 25 spacings across. Where the ground is on the convex
+  // hull of the cloud (a dip, a crest) the rim points have Delaunay edges along the
+  // hull hundreds of spacings long; counted in their local spacing, they made the
+  // holes look sampled at their own scale, and the walk covered one with 11
+  // triangles up to 19 spacings long (6 loops; localSpacing() now leaves such
+  // edges out).
+  constexpr std::size_t N = 100000;
+  const std::array<Eigen::Vector3d, 6> holes{{{-0.75, 0.1, 0.06},
+                                              {0.1, -0.75, 0.05},
+                                              {0.8, -0.1, 0.07},
+                                              {-0.1, 0.85, 0.05},
+                                              {0.1, 0.3, 0.04},
+                                              {0.55, 0.45, 0.08}}};
+  // Within margin of a hole's circle (a triangle at the rim, between samples
+  // round it, reaches in by a fraction of a spacing).
+  const auto in_hole = [&](double x, double y, double margin = 0.0) {
+    for (const auto& h : holes)
+      if (std::hypot(x - h.x(), y - h.y()) < h.z() - margin)
+        return true;
+    return false;
+  };
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> points;
+  while (points.size() < N) {
+    const double x = uniform(rng), y = uniform(rng);
+    if (!in_hole(x, y))
+      points.emplace_back(x, y, 0.05 * std::sin(2.1 * x + 0.3) * std::cos(1.7 * y));
+  }
+  const Result r =
+      pcl::cocone::run(points, Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  const auto topology = pcl::cocone::analyzeMesh(r.triangles, r.vertices);
+  const double spacing = std::sqrt(4.0 / N);
+  std::size_t covering = 0;
+  double longest = 0.0;
+  for (const auto& t : r.polygons) {
+    const Eigen::Vector3d c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+    covering += in_hole(c.x(), c.y(), spacing);
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (points[t[k]] - points[t[(k + 1) % 3]]).norm());
+  }
+  std::printf("[ measured ] rolling ground with 6 holes: %zu loops, Euler %ld, %zu "
+              "triangles over a hole, longest edge %.1f spacings\n",
+              r.border_loops.size(),
+              topology.euler,
+              covering,
+              longest / spacing);
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(covering, 0u);
+  EXPECT_EQ(r.border_loops.size(), 7u);
+  EXPECT_EQ(topology.euler, 1 - 6);
+  EXPECT_EQ(topology.components, 1u);
 }

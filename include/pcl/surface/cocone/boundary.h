@@ -28,7 +28,9 @@ struct FlatnessParameters {
 };
 
 /** \brief Local sample spacing s_p: the mean distance of p to its 6 nearest Delaunay
- * neighbours (VoronoiCells::nearest), maximised over p and those neighbours.
+ * neighbours (VoronoiCells::nearest) but those more than 10 times as far as their
+ * median (edges across a hole or along the convex hull), maximised over p and those
+ * neighbours.
  *
  * The width of an interior Voronoi cell is about the spacing whatever the scale or
  * the noise (w / s <= 1.3 measured), while at a border the cell reaches out several
