@@ -909,11 +909,14 @@ private:
     incidences = EdgeIncidences(triangles, threads_);
 
     // The seam holes, closed with the tiles' triangles.
-    const auto border = [&](int a, int b) {
-      const auto e = incidences.find(a, b);
-      return e >= 0 && incidences.count(static_cast<std::size_t>(e)) == 1;
-    };
     const auto core_of = [&](int x) { return tileOfVertex(band_vertex_[x]); };
+    const auto tile_of = [&](int t) {
+      return static_cast<int>(std::upper_bound(patch_begin_.begin(),
+                                               patch_begin_.end(),
+                                               static_cast<std::size_t>(patch_of[t])) -
+                              patch_begin_.begin()) -
+             1;
+    };
     report_.tiling.seam_filled = fillHoles(
         P,
         triangles,
@@ -925,8 +928,7 @@ private:
               (!inner[t[0]] && !inner[t[2]]))
             return false;
           return std::binary_search(seen.begin(), seen.end(), t) ||
-                 (border(t[0], t[1]) && border(t[1], t[2]) && border(t[0], t[2]) &&
-                  (core_of(t[0]) != core_of(t[1]) || core_of(t[0]) != core_of(t[2])));
+                 detail::closesSeamHole(incidences, t, core_of, tile_of);
         },
         detail::SEAM_HOLE_EDGES,
         &incidences);

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -283,6 +284,34 @@ forEachTile(std::size_t count, int workers, const Body& body)
   }
   for (auto& thread : pool)
     thread.join();
+}
+
+/** Whether the stitch closes a hole of three edges by its own triangle \a t (ids
+ * ascending, none of the tiles kept it): its edges are border edges and it lies on a
+ * seam, its vertices in more than one core or the triangles at its edges from more
+ * than one tile. Tiles that triangulate a flat spot of five or more points
+ * differently leave such a hole; on a 100M torus one had all three vertices in one
+ * core, its edges' triangles from two tiles.
+ * \param[in] incidences of the stitched triangles
+ * \param[in] core_of per vertex, the tile whose core holds it
+ * \param[in] tile_of per triangle (an index into what \a incidences group), the tile
+ *            that kept it */
+template <typename CoreOf, typename TileOf>
+bool
+closesSeamHole(const EdgeIncidences& incidences,
+               const Triangle& t,
+               const CoreOf& core_of,
+               const TileOf& tile_of)
+{
+  std::array<int, 3> tile{};
+  for (int k = 0; k < 3; ++k) {
+    const std::ptrdiff_t e = incidences.find(t[k], t[(k + 1) % 3]);
+    if (e < 0 || incidences.count(static_cast<std::size_t>(e)) != 1)
+      return false;
+    tile[k] = tile_of(incidences.triangle[incidences.first[e]]);
+  }
+  return core_of(t[0]) != core_of(t[1]) || core_of(t[0]) != core_of(t[2]) ||
+         tile[0] != tile[1] || tile[0] != tile[2];
 }
 
 /** One entry per hole among the holes the tiles closed, each given as (whether

@@ -525,22 +525,18 @@ stitch(TilePlan& plan,
   std::vector<int>().swap(tile_of_triangle);
   std::sort(seen.begin(), seen.end());
   seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
-  // A seam hole of three edges whose triangle no tile made (where tiles triangulate
-  // a flat spot of five or more points differently) is closed by that triangle.
-  const auto border = [&](int a, int b) {
-    const auto e = incidences.find(a, b);
-    return e >= 0 && incidences.count(static_cast<std::size_t>(e)) == 1;
-  };
+  // A seam hole of three edges whose triangle no tile made is closed by that
+  // triangle (closesSeamHole()).
   const auto core_of = [&](int v) {
     return plan.point_tile[ids.position(result.representative[v])];
   };
+  const auto tile_of = [&](int t) { return kept_by[t]; };
   report.seam_filled = fillHoles(
       result.positions,
       triangles,
       [&](const Triangle& t) {
         return std::binary_search(seen.begin(), seen.end(), t) ||
-               (border(t[0], t[1]) && border(t[1], t[2]) && border(t[0], t[2]) &&
-                (core_of(t[0]) != core_of(t[1]) || core_of(t[0]) != core_of(t[2])));
+               detail::closesSeamHole(incidences, t, core_of, tile_of);
       },
       SEAM_HOLE_EDGES,
       &incidences);
