@@ -123,7 +123,8 @@ struct TilingReport {
   std::size_t seam_dropped = 0;
   /** What the repair of the stitched mesh changed (at the seams). */
   RepairCounts stitch;
-  /** Triangles added to close seam holes, from the tiles' own meshes. */
+  /** Triangles added to close seam holes: from the tiles' own meshes, or a hole's
+   * own triangle. */
   std::size_t seam_filled = 0;
   /** Wall-clock time of cutting the cloud into tiles and finding their halos
    * (planTiles()), in milliseconds. */
@@ -334,8 +335,10 @@ stitchTiles(TilePlan plan,
  * patches say so (the agreement of most shared edges, strongest pairs first); the
  * union is then made an oriented 2-manifold by repairManifold() (where tiles
  * disagree at a seam an edge may have three triangles or a vertex two fans), small
- * seam holes are closed with triangles of the tiles' own meshes (fillHoles()), each
- * component faces outward, and the border loops are those of the whole mesh.
+ * seam holes are closed with triangles of the tiles' own meshes (fillHoles()), and a
+ * seam hole of three edges by its own triangle when its vertices lie in two cores or
+ * more or its edges' triangles come from two tiles or more, each component faces
+ * outward, and the border loops are those of the whole mesh.
  *
  * The Result's fields read as those of run(): polygons, border_loops,
  * boundary_indices, outlier_indices and point_noise over the caller's ids,
