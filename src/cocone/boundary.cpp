@@ -7,6 +7,7 @@
 #include <pcl/surface/cocone/complex.h>
 
 #include "edge_sort.h"
+#include "points.h"
 
 #include <algorithm>
 #include <array>
@@ -24,31 +25,11 @@ localSpacing(const std::vector<Eigen::Vector3d>& points,
 {
   constexpr int K = 6;
   const auto n = static_cast<std::ptrdiff_t>(points.size());
-  // A Delaunay neighbour more than FAR times as far as the median of the K nearest
-  // is not one of the samples round p but across a hole or along the convex hull:
-  // measured on a random terrain (1M points), a rim point of a flat hole 30 spacings
-  // wide had 4 neighbours within 1.5 spacings and 2 at 270 and 1000 (hull edges);
-  // their mean made the hole pass for sampled at its own scale, and the walk
-  // covered it with triangles 55 spacings long (3 of the 6 holes; 100k and 300k
-  // points: 3 and 1). At 10 or 20 none is covered; at 50 the 100k terrain's are
-  // again; at 4 the casting's vertex set (faces sampled along their outlines only)
-  // keeps 3 more loops, at 10 one more.
-  constexpr double FAR = 10.0;
   std::vector<double> mean(n, 0.0);
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)
-  for (std::ptrdiff_t v = 0; v < n; ++v) {
-    std::array<double, K> d;
-    int count = 0;
-    for (; count < K && cells.nearest[v][count] >= 0; ++count)
-      d[count] = (points[cells.nearest[v][count]] - points[v]).norm();
-    if (count == 0)
-      continue;
-    const double bound = FAR * d[(count - 1) / 2]; // nearest first
-    int kept = 0;
-    for (int k = 0; k < count && d[k] <= bound; ++k, ++kept)
-      mean[v] += d[k];
-    mean[v] /= kept;
-  }
+  for (std::ptrdiff_t v = 0; v < n; ++v)
+    mean[v] =
+        detail::meanNeighbourDistance(points, cells.nearest[v], static_cast<int>(v), K);
   std::vector<double> s = mean;
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)
   for (std::ptrdiff_t v = 0; v < n; ++v)

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "parallel.h"
+#include "points.h"
 
 #include <algorithm>
 #include <cmath>
@@ -315,9 +316,9 @@ private:
 };
 
 /** The number of p's nearest neighbours within three local spacings (the mean
- * distance to the 6 nearest, written to \a spacing): the Delaunay neighbours of a
- * surface sample include long edges across the inside or the outside, which are not
- * the surface's. */
+ * distance to the 6 nearest, meanNeighbourDistance(), written to \a spacing): the
+ * Delaunay neighbours of a surface sample include long edges across the inside or
+ * the outside, which are not the surface's. */
 int
 nearNeighbours(const std::vector<Eigen::Vector3d>& points,
                const std::array<int, NEAREST>& list,
@@ -325,10 +326,7 @@ nearNeighbours(const std::vector<Eigen::Vector3d>& points,
                double* spacing)
 {
   const int c = count(list);
-  double distance = 0.0;
-  for (int i = 0; i < std::min(c, SPACING_NEIGHBOURS); ++i)
-    distance += (points[list[i]] - points[p]).norm();
-  *spacing = c ? distance / std::min(c, SPACING_NEIGHBOURS) : 0.0;
+  *spacing = detail::meanNeighbourDistance(points, list, p, SPACING_NEIGHBOURS);
   const double reach2 = 9.0 * *spacing * *spacing;
   int k = 0;
   while (k < c && (points[list[k]] - points[p]).squaredNorm() <= reach2)

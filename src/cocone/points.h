@@ -25,6 +25,38 @@ isFinite(const Eigen::Vector3d& p)
   return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
 }
 
+/** Mean distance from \a p to its nearest Delaunay neighbours \a list (nearest
+ * first, -1 after the last), the first \a k of them, leaving out those more than 10
+ * times as far as their median: an edge across a hole or along the convex hull is
+ * not one of the samples round p. Measured on a random terrain (1M points): a rim
+ * point of a flat hole 30 spacings wide had 4 neighbours within 1.5 spacings and 2
+ * at 270 and 1,000 (hull edges); their mean made the hole pass for sampled at its
+ * own scale and the walk covered it with triangles 55 spacings long (3 of 6 holes;
+ * at 100k and 300k points 3 and 1). At 10 or 20 none is covered, at 50 the 100k
+ * terrain's are again; at 4 the casting's vertex set (faces sampled along their
+ * outlines only) keeps 3 more loops, at 10 one more. */
+template <std::size_t N>
+double
+meanNeighbourDistance(const std::vector<Eigen::Vector3d>& points,
+                      const std::array<int, N>& list,
+                      int p,
+                      int k)
+{
+  constexpr double FAR = 10.0;
+  std::array<double, N> d;
+  int count = 0;
+  for (; count < k && count < static_cast<int>(N) && list[count] >= 0; ++count)
+    d[count] = (points[list[count]] - points[p]).norm();
+  if (count == 0)
+    return 0.0;
+  const double bound = FAR * d[(count - 1) / 2];
+  double sum = 0.0;
+  int kept = 0;
+  for (; kept < count && d[kept] <= bound; ++kept)
+    sum += d[kept];
+  return sum / kept;
+}
+
 /** Whether edge ab is at most \a reach times the larger local spacing of its ends
  * long: as short as the triangles of the sampling there. */
 inline bool
