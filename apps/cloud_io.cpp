@@ -104,7 +104,7 @@ namespace {
 bool
 checkPcdHeader(const std::string& path, std::string& error)
 {
-  const std::set<std::string>& KEYS = pcdHeaderKeys();
+  const std::set<std::string>& keys = pcdHeaderKeys();
   std::ifstream in(path, std::ios::binary);
   std::vector<std::string> fields, sizes, types, counts;
   std::size_t width = 0, height = 1, points = 0;
@@ -133,7 +133,7 @@ checkPcdHeader(const std::string& path, std::string& error)
     if (key.empty() || key[0] == '#')
       continue;
     // Only the keys of the format, each once: PCL's parser matches others loosely.
-    if (!KEYS.count(key) || !seen.insert(key).second)
+    if (!keys.count(key) || !seen.insert(key).second)
       break;
     if (key == "FIELDS" || key == "COLUMNS")
       fields = values;
@@ -208,7 +208,7 @@ checkPcdHeader(const std::string& path, std::string& error)
     tokens >> first;
     if (buffer[0] == '\0' || (!first.empty() && first[0] == '#'))
       continue;
-    for (const auto& key : KEYS)
+    for (const auto& key : keys)
       if (first.compare(0, key.size(), key) == 0)
         return false;
     break;

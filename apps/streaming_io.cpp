@@ -338,7 +338,7 @@ readPlyHeader(std::FILE* file, std::uint64_t file_size, Layout& l, std::string& 
 bool
 readPcdHeader(std::FILE* file, Layout& l, std::string& why)
 {
-  const std::set<std::string>& KEYS = pcdHeaderKeys();
+  const std::set<std::string>& keys = pcdHeaderKeys();
   std::vector<std::string> fields, sizes, types, counts, w;
   std::size_t width = 0, height = 1, points = 0;
   bool have_width = false, have_points = false;
@@ -350,7 +350,7 @@ readPcdHeader(std::FILE* file, Layout& l, std::string& why)
     if (w.empty() || w[0][0] == '#')
       continue;
     const std::string key = w[0];
-    if (!KEYS.count(key) || !seen.insert(key).second)
+    if (!keys.count(key) || !seen.insert(key).second)
       return false;
     w.erase(w.begin());
     if (key == "FIELDS" || key == "COLUMNS")
