@@ -10,6 +10,7 @@
 #include <CGAL/Constrained_triangulation_face_base_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <Eigen/Dense>
@@ -88,10 +89,58 @@ toCgal(const Eigen::Vector3d& p)
   return {p.x(), p.y(), p.z()};
 }
 
+/** Whether \a patch closes \a loop as a disk glued along it: each loop edge in one
+ * patch triangle, run against the loop; every other edge in two, once each way, and
+ * not in the mesh; no triangle with a corner twice; V - E + F = 1. Checked for every
+ * patch, whichever way it was made: a patch maker misled by a degenerate loop (its
+ * vertices collinear, a sample on it) leaves the loop open, never the mesh
+ * non-manifold. */
+bool
+closesLoop(const std::vector<int>& loop,
+           const std::vector<Triangle>& patch,
+           const EdgeIncidences& incidences)
+{
+  std::vector<std::array<int, 2>> half;
+  std::vector<int> corners;
+  for (const auto& t : patch) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+      return false;
+    for (int c = 0; c < 3; ++c) {
+      half.push_back({t[c], t[(c + 1) % 3]});
+      corners.push_back(t[c]);
+    }
+  }
+  std::sort(half.begin(), half.end());
+  if (std::adjacent_find(half.begin(), half.end()) != half.end())
+    return false;
+  const auto has = [&](int a, int b) {
+    return std::binary_search(half.begin(), half.end(), std::array<int, 2>{a, b});
+  };
+  const std::size_t k = loop.size();
+  for (std::size_t i = 0; i < k; ++i)
+    if (!has(loop[(i + 1) % k], loop[i]) || has(loop[i], loop[(i + 1) % k]))
+      return false;
+  std::size_t single = 0, paired = 0;
+  for (const auto& [a, b] : half) {
+    if (!has(b, a))
+      ++single;
+    else if (incidences.find(a, b) >= 0)
+      return false;
+    else
+      ++paired;
+  }
+  if (single != k) // the loop's edges and no other
+    return false;
+  std::sort(corners.begin(), corners.end());
+  const auto vertices = std::unique(corners.begin(), corners.end()) - corners.begin();
+  const auto edges = static_cast<std::ptrdiff_t>(k + paired / 2);
+  return vertices - edges + static_cast<std::ptrdiff_t>(patch.size()) == 1;
+}
+
 /** Close each loop that may be closed (3 to \a max_edges edges, not on a true
  * border) with the triangles \a patch_of(loop, patch) appends to patch, facing as the
- * mesh (false: the loop stays open). The loops left open stay in \a loops; the
- * incidences take in the triangles added. */
+ * mesh (false, or a patch that is no disk on the loop: the loop stays open). The
+ * loops left open stay in \a loops; the incidences take in the triangles added. */
 template <typename PatchOf>
 HoleFilling
 closeLoops(std::vector<Triangle>& triangles,
@@ -108,7 +157,7 @@ closeLoops(std::vector<Triangle>& triangles,
   for (auto& loop : loops) {
     patch.clear();
     if (loop.size() < 3 || loop.size() > max_edges || onTrueBorder(loop, true_border) ||
-        !patch_of(loop, patch)) {
+        !patch_of(loop, patch) || !closesLoop(loop, patch, incidences)) {
       open.push_back(std::move(loop));
       continue;
     }
@@ -863,7 +912,10 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<std::uint8_t>& true_border)
 {
   using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
-  using Fb = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+  using Fb = CGAL::Triangulation_face_base_with_info_2<
+      bool,
+      Kernel,
+      CGAL::Constrained_triangulation_face_base_2<Kernel>>; // outside the loop
   using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
   using Cdt = CGAL::
       Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
@@ -893,6 +945,7 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
           neighbour[at[t.v[i]]++] = t.v[(i + j) % 3];
   };
   std::vector<int> seen(n, -1), inner, stack;
+  std::vector<Cdt::Face_handle> stack_faces;
   int stamp = 0;
   const auto patch_of = [&](const std::vector<int>& loop,
                             std::vector<Triangle>& patch) {
@@ -966,25 +1019,33 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
       cdt.insert_constraint(rim[i], rim[(i + 1) % k]);
     for (const int q : inner)
       cdt.insert(point2(hole.flat(points[q])))->info() = q;
-    // Distinct in the plane (no two projected onto one point), every new edge short
-    // and new to the mesh.
+    // Distinct in the plane (no two projected onto one point), every new edge short.
     if (cdt.number_of_vertices() != k + inner.size())
       return false;
+    // Outside the loop: the faces reached from the infinite one without crossing it
+    // (exact; a centroid test is not where rim vertices are collinear).
+    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+      f->info() = false;
+    stack_faces.assign(1, cdt.infinite_face());
+    cdt.infinite_face()->info() = true;
+    while (!stack_faces.empty()) {
+      const Cdt::Face_handle f = stack_faces.back();
+      stack_faces.pop_back();
+      for (int e = 0; e < 3; ++e)
+        if (!f->is_constrained(e) && !f->neighbor(e)->info()) {
+          f->neighbor(e)->info() = true;
+          stack_faces.push_back(f->neighbor(e));
+        }
+    }
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-      const Eigen::Vector2d centroid = (hole.flat(points[f->vertex(0)->info()]) +
-                                        hole.flat(points[f->vertex(1)->info()]) +
-                                        hole.flat(points[f->vertex(2)->info()])) /
-                                       3.0;
-      if (!hole.inside(centroid))
+      if (f->info())
         continue;
       const Triangle t{
           f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
-      for (int e = 0; e < 3; ++e) {
-        const int a = t[e], b = t[(e + 1) % 3];
+      for (int e = 0; e < 3; ++e)
         if (!f->is_constrained((e + 2) % 3) && // the edge opposite corner e + 2
-            (!withinReach(points, spacing, reach, a, b) || incidences.find(a, b) >= 0))
+            !withinReach(points, spacing, reach, t[e], t[(e + 1) % 3]))
           return false;
-      }
       patch.push_back(t);
     }
     // Counter-clockwise in the plane; the patch runs against the loop, which has the
