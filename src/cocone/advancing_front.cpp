@@ -141,6 +141,16 @@ advancingFront(const std::vector<Eigen::Vector3d>& points,
   return triangles;
 }
 
+/** A piece with no free samples round it whose triangles' vector area is at least
+ * this share of their area is a sheet facing one way: the advancing front over its
+ * vertices alone closes it never (the other side would need vertices of its own).
+ * Measured over the tests, the quality table, the closed meshes and the range scans:
+ * every piece the advancing front closed had a share of 0.05 or less, and free
+ * samples; those without free samples that it did not close had 0.43 to 0.98, as
+ * had the tiles of a saddle, whose cut loop left the whole tile (128,000 points, 3
+ * to 4 s each) to it. */
+constexpr double ONE_SIDED_SHARE = 0.5;
+
 /** analyzeMesh() of triangles on the listed vertices (ascending), in time of their
  * number. */
 MeshTopology
@@ -191,9 +201,16 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> piece(n, -1);
   std::vector<long> euler(pieces, 0);
   std::vector<std::size_t> size(pieces, 0);
+  std::vector<Eigen::Vector3d> vector_area(pieces, Eigen::Vector3d::Zero());
+  std::vector<double> area(pieces, 0.0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const int p = piece_of_triangle[t];
     euler[p] += 1;
+    const Triangle& c = triangles[t];
+    const Eigen::Vector3d normal =
+        (points[c[1]] - points[c[0]]).cross(points[c[2]] - points[c[0]]);
+    vector_area[p] += normal;
+    area[p] += normal.norm();
     for (const int v : triangles[t])
       if (piece[v] < 0) {
         piece[v] = p;
@@ -272,7 +289,10 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
           vertices.push_back(b);
         }
       }
-    if (static_cast<double>(vertices.size()) > most)
+    const int p = candidates[i];
+    if (static_cast<double>(vertices.size()) > most ||
+        (vertices.size() == size[p] &&
+         vector_area[p].norm() >= ONE_SIDED_SHARE * area[p]))
       vertices.clear();
   }
   std::vector<std::uint8_t> replaced(pieces, 0), taken(n, 0);

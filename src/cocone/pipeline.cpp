@@ -23,6 +23,7 @@
 
 #include "caller_ids.h"
 #include "edge_sort.h"
+#include "points.h"
 #include "stopwatch.h"
 
 #include <algorithm>
@@ -216,6 +217,17 @@ reconstruct(Triangulation& dt,
     // coarsely for the flatness test. What those leave, the advancing front's may:
     // the vertex density changing faster than the co-cones follow. Only there, and
     // a few rings around, does either mesh need making.
+    // The rings grow through co-cone triangles of the surface round the holes, not
+    // through those along the convex hull or across a wide void (an edge of more
+    // than FAR_NEIGHBOUR spacings): at a tile's cut those reached over most of the
+    // tile (75,000 of 128,000 points for a 1M saddle's tile of 125,000, the
+    // advancing front then taking 44 % of its time).
+    const auto near_triangle = [&](const Triangle& t) {
+      const auto near = [&](int a, int b) {
+        return detail::withinReach(dt.points, spacing, detail::FAR_NEIGHBOUR, a, b);
+      };
+      return near(t[0], t[1]) && near(t[1], t[2]) && near(t[0], t[2]);
+    };
     const auto open_region = [&](int rings, bool free_points) {
       std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
       for (const auto& t : result.triangles)
@@ -230,7 +242,8 @@ reconstruct(Triangulation& dt,
       for (int ring = 0; ring < rings; ++ring) {
         std::vector<std::uint8_t> grown = region;
         for (const auto& t : cells.triangles)
-          if (region[t.v[0]] || region[t.v[1]] || region[t.v[2]])
+          if ((region[t.v[0]] || region[t.v[1]] || region[t.v[2]]) &&
+              near_triangle(t.v))
             grown[t.v[0]] = grown[t.v[1]] = grown[t.v[2]] = 1;
         for (const auto& t : result.triangles)
           if (region[t[0]] || region[t[1]] || region[t[2]])

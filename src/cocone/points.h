@@ -25,6 +25,11 @@ isFinite(const Eigen::Vector3d& p)
   return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
 }
 
+/** A neighbour more than this many local spacings away is across a hole or along
+ * the convex hull, not a sample of the surface round a point: the sampling density
+ * is assumed to change by less than this within a point's neighbourhood. */
+constexpr double FAR_NEIGHBOUR = 10.0;
+
 /** Mean distance from \a p to its nearest Delaunay neighbours \a list (nearest
  * first, -1 after the last), the first \a k of them, leaving out those more than 10
  * times as far as their median: an edge across a hole or along the convex hull is
@@ -42,14 +47,13 @@ meanNeighbourDistance(const std::vector<Eigen::Vector3d>& points,
                       int p,
                       int k)
 {
-  constexpr double FAR = 10.0;
   std::array<double, N> d;
   int count = 0;
   for (; count < k && count < static_cast<int>(N) && list[count] >= 0; ++count)
     d[count] = (points[list[count]] - points[p]).norm();
   if (count == 0)
     return 0.0;
-  const double bound = FAR * d[(count - 1) / 2];
+  const double bound = FAR_NEIGHBOUR * d[(count - 1) / 2];
   double sum = 0.0;
   int kept = 0;
   for (; kept < count && d[kept] <= bound; ++kept)
