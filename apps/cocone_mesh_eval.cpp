@@ -5,7 +5,7 @@
  * cocone_mesh_eval: the topology of the reconstruction of closed reference shapes,
  * next to CGAL's advancing front, as a Markdown table.
  *
- *   cocone_mesh_eval [--threads T] [--no-peer] FILE[:EULER] ...
+ *   cocone_mesh_eval [--threads T] [--no-peer] [--noise S [--seed N]] FILE[:EULER] ...
  *
  * e.g. cocone_mesh_eval ../shared/data/closed_meshes/bunny.obj
  *        ../shared/data/powercrust_samples/knot.pts:0
@@ -25,6 +25,10 @@
  * of the 5 largest and the median, the outliers the library set aside, and the
  * seconds. The peer's loops are the cycles of its boundary edges. The last column
  * says whether this library has at most as many wrong loops as the peer.
+ *
+ * --noise S: a noisy scan of each shape, both methods on the same cloud: every
+ * point moved by Gaussian noise of S local spacings (the mean distance to its 6
+ * nearest other points) per coordinate, from seed N (default 1).
  */
 
 #include <pcl/surface/cocone/mesh_checks.h>
@@ -32,14 +36,17 @@
 
 #include "benchmark_advancing_front.h"
 #include "cloud_io.h"
+#include "peer_methods.h"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -53,6 +60,36 @@ double
 since(std::chrono::steady_clock::time_point t)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/** Every point moved by Gaussian noise of \a sigma local spacings (the mean distance
+ * to its 6 nearest other points) per coordinate, drawn from \a seed. */
+void
+addNoise(std::vector<Eigen::Vector3d>& points, double sigma, unsigned int seed)
+{
+  constexpr int K = 6;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const Eigen::Vector3d& p : points)
+    cloud->push_back(pcl::PointXYZ(static_cast<float>(p.x()),
+                                   static_cast<float>(p.y()),
+                                   static_cast<float>(p.z())));
+  cocone_app::Tree tree;
+  tree.setInputCloud(cloud);
+  std::vector<double> spacing(points.size(), 0.0);
+  pcl::Indices near;
+  std::vector<float> d2;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int found = tree.nearestKSearch((*cloud)[i], K + 1, near, d2);
+    double sum = 0.0;
+    for (int j = 1; j < found; ++j) // the first is the point itself
+      sum += std::sqrt(static_cast<double>(d2[j]));
+    spacing[i] = found > 1 ? sum / (found - 1) : 0.0;
+  }
+  std::mt19937 random(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      points[i][c] += sigma * spacing[i] * normal(random);
 }
 
 /** What is known of the true surface of a cloud. */
@@ -335,8 +372,9 @@ baseName(const std::string& path)
 int
 main(int argc, char** argv)
 {
-  unsigned int threads = 1;
+  unsigned int threads = 1, seed = 1;
   bool peer = true;
+  double noise = 0.0;
   std::vector<std::string> files;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -344,6 +382,10 @@ main(int argc, char** argv)
       threads = static_cast<unsigned int>(std::strtoul(argv[++a], nullptr, 10));
     else if (arg == "--no-peer")
       peer = false;
+    else if (arg == "--noise" && a + 1 < argc)
+      noise = std::strtod(argv[++a], nullptr);
+    else if (arg == "--seed" && a + 1 < argc)
+      seed = static_cast<unsigned int>(std::strtoul(argv[++a], nullptr, 10));
     else if (arg.size() > 1 && arg[0] == '-') {
       std::fprintf(stderr, "unknown option '%s'\n", arg.c_str());
       return 1;
@@ -351,9 +393,15 @@ main(int argc, char** argv)
     else
       files.push_back(arg);
   }
+  if (!(noise >= 0.0) || !std::isfinite(noise)) {
+    std::fprintf(stderr, "--noise takes a number of local spacings, 0 or more\n");
+    return 1;
+  }
   if (files.empty()) {
     std::fprintf(
-        stderr, "usage: %s [--threads T] [--no-peer] FILE[:EULER] ...\n", argv[0]);
+        stderr,
+        "usage: %s [--threads T] [--no-peer] [--noise S [--seed N]] FILE[:EULER] ...\n",
+        argv[0]);
     return 1;
   }
   std::printf("| cloud | truth | method | points | mesh vertices | triangles | "
@@ -395,6 +443,8 @@ main(int argc, char** argv)
         truth.unreferenced = points.size() - truth.topology.vertices;
       }
     }
+    if (noise > 0.0)
+      addNoise(points, noise, seed);
     const std::string name = baseName(path);
     const std::string truth_text = truthText(truth);
     std::fprintf(stderr, "%s: %zu points\n", path.c_str(), points.size());
