@@ -172,6 +172,15 @@ CoConeBoundary<PointInT>::compute(cocone::Stages stages, const char* caller)
             result_.outlier_indices.size(),
             result_.boundary_indices.size(),
             result_.triangles.size());
+  if (stages == cocone::Stages::RECONSTRUCTION && result_.triangles.empty() &&
+      parameters_.boundary_detection && !result_.boundary_indices.empty())
+    PCL_WARN("[pcl::%s::%s] No point reads as well sampled (%zu undersampled): the "
+             "mesh is empty. The cloud is too coarse or too noisy for the flatness "
+             "test; a larger normal angle (setNormalAngle ()) or no boundary "
+             "detection (setBoundaryDetection (false)) meshes it.\n",
+             getClassName().c_str(),
+             caller,
+             result_.boundary_indices.size());
   return true;
 }
 
