@@ -373,7 +373,8 @@ stitchTiles(TilePlan plan,
  * components, border loops) is that of one piece on the torus and the saddle, not
  * where tiles are small against the features: a 1M terrain with steep walls in 8
  * tiles of 125,000 points has 20 loops against 9 (a wall one tile's ratio reads as
- * undersampled; with the ratio given, 16: holes drawn out along the cuts).
+ * undersampled; with the ratio given, 16: the 7 extra loops each cross a cut, holes
+ * the one piece closes that run out of both tiles' halos).
  *
  * The output does not depend on the number of threads or tiles in flight. A tile
  * that fails for lack of memory fails the run (Result::error); a degenerate tile
