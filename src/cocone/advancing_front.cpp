@@ -201,16 +201,9 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> piece(n, -1);
   std::vector<long> euler(pieces, 0);
   std::vector<std::size_t> size(pieces, 0);
-  std::vector<Eigen::Vector3d> vector_area(pieces, Eigen::Vector3d::Zero());
-  std::vector<double> area(pieces, 0.0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const int p = piece_of_triangle[t];
     euler[p] += 1;
-    const Triangle& c = triangles[t];
-    const Eigen::Vector3d normal =
-        (points[c[1]] - points[c[0]]).cross(points[c[2]] - points[c[0]]);
-    vector_area[p] += normal;
-    area[p] += normal.norm();
     for (const int v : triangles[t])
       if (piece[v] < 0) {
         piece[v] = p;
@@ -258,6 +251,19 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
   for (int v = 0; v < n; ++v)
     if (piece[v] >= 0 && slot[piece[v]] >= 0)
       region[slot[piece[v]]].push_back(v);
+  // Each candidate's vector area and area (twice), for the one-sided test below.
+  std::vector<Eigen::Vector3d> vector_area(candidates.size(), Eigen::Vector3d::Zero());
+  std::vector<double> area(candidates.size(), 0.0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const int i = slot[piece_of_triangle[t]];
+    if (i < 0)
+      continue;
+    const Triangle& c = triangles[t];
+    const Eigen::Vector3d normal =
+        (points[c[1]] - points[c[0]]).cross(points[c[2]] - points[c[0]]);
+    vector_area[i] += normal;
+    area[i] += normal.norm();
+  }
   // Per vertex its free co-cone neighbours, in compressed rows.
   std::vector<std::size_t> first(n + 1, 0);
   for (const auto& t : cocone_triangles)
@@ -289,10 +295,9 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
           vertices.push_back(b);
         }
       }
-    const int p = candidates[i];
     if (static_cast<double>(vertices.size()) > most ||
-        (vertices.size() == size[p] &&
-         vector_area[p].norm() >= ONE_SIDED_SHARE * area[p]))
+        (vertices.size() == size[candidates[i]] &&
+         vector_area[i].norm() >= ONE_SIDED_SHARE * area[i]))
       vertices.clear();
   }
   std::vector<std::uint8_t> replaced(pieces, 0), taken(n, 0);
@@ -309,9 +314,9 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     bool ok = theirs.manifold() && theirs.components == 1 &&
               theirs.boundary_edges == 0 &&
               theirs.euler == euler[p] + static_cast<long>(holes[p]);
-    for (const auto& t : front)
-      for (int c = 0; c < 3 && ok; ++c)
-        ok = detail::withinReach(points, spacing, reach, t[c], t[(c + 1) % 3]);
+    ok = ok && std::all_of(front.begin(), front.end(), [&](const Triangle& t) {
+           return detail::triangleWithinReach(points, spacing, reach, t);
+         });
     // A free sample closes one piece at most.
     for (const int v : region[i])
       ok = ok && !taken[v];

@@ -222,12 +222,6 @@ reconstruct(Triangulation& dt,
     // than FAR_NEIGHBOUR spacings): at a tile's cut those reached over most of the
     // tile (75,000 of 128,000 points for a 1M saddle's tile of 125,000, the
     // advancing front then taking 44 % of its time).
-    const auto near_triangle = [&](const Triangle& t) {
-      const auto near = [&](int a, int b) {
-        return detail::withinReach(dt.points, spacing, detail::FAR_NEIGHBOUR, a, b);
-      };
-      return near(t[0], t[1]) && near(t[1], t[2]) && near(t[0], t[2]);
-    };
     const auto open_region = [&](int rings, bool free_points) {
       std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
       for (const auto& t : result.triangles)
@@ -243,7 +237,8 @@ reconstruct(Triangulation& dt,
         std::vector<std::uint8_t> grown = region;
         for (const auto& t : cells.triangles)
           if ((region[t.v[0]] || region[t.v[1]] || region[t.v[2]]) &&
-              near_triangle(t.v))
+              detail::triangleWithinReach(
+                  dt.points, spacing, detail::FAR_NEIGHBOUR, t.v))
             grown[t.v[0]] = grown[t.v[1]] = grown[t.v[2]] = 1;
         for (const auto& t : result.triangles)
           if (region[t[0]] || region[t[1]] || region[t[2]])

@@ -31,10 +31,10 @@ isFinite(const Eigen::Vector3d& p)
 constexpr double FAR_NEIGHBOUR = 10.0;
 
 /** Mean distance from \a p to its nearest Delaunay neighbours \a list (nearest
- * first, -1 after the last), the first \a k of them, leaving out those more than 10
- * times as far as their median: an edge across a hole or along the convex hull is
- * not one of the samples round p. Measured on a random terrain (1M points): a rim
- * point of a flat hole 30 spacings wide had 4 neighbours within 1.5 spacings and 2
+ * first, -1 after the last), the first \a k of them, leaving out those more than
+ * FAR_NEIGHBOUR times as far as their median: an edge across a hole or along the convex
+ * hull is not one of the samples round p. Measured on a random terrain (1M points): a
+ * rim point of a flat hole 30 spacings wide had 4 neighbours within 1.5 spacings and 2
  * at 270 and 1,000 (hull edges); their mean made the hole pass for sampled at its
  * own scale and the walk covered it with triangles 55 spacings long (3 of 6 holes;
  * at 100k and 300k points 3 and 1). At 10 or 20 none is covered, at 50 the 100k
@@ -72,6 +72,19 @@ withinReach(const std::vector<Eigen::Vector3d>& points,
 {
   const double longest = reach * std::max(spacing[a], spacing[b]);
   return (points[a] - points[b]).squaredNorm() <= longest * longest;
+}
+
+/** Whether every edge of \a t is withinReach(). */
+template <typename Corners>
+inline bool
+triangleWithinReach(const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<double>& spacing,
+                    double reach,
+                    const Corners& t)
+{
+  return withinReach(points, spacing, reach, t[0], t[1]) &&
+         withinReach(points, spacing, reach, t[1], t[2]) &&
+         withinReach(points, spacing, reach, t[2], t[0]);
 }
 
 /** Lexicographic order of coordinates: the canonical order for tie-breaks. */
