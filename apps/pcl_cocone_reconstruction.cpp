@@ -400,6 +400,7 @@ reconstructOutOfCore(const Options& o,
         << ", \"smoothed\": " << (r.smoothed ? "true" : "false")
         << "},\n  \"outliers\": " << r.outlier_indices.size()
         << ",\n  \"outlier_indices\": " << jsonList(r.outlier_indices)
+        << ",\n  \"unmeshed_part_triangles\": " << r.counts.unmeshed_parts
         << ",\n  \"true_borders\": " << r.counts.true_borders
         << ",\n  \"holes_filled\": " << r.holes_filled
         << ",\n  \"hole_triangles\": " << r.counts.hole_triangles
@@ -717,6 +718,8 @@ main(int argc, char** argv)
       << ", \"smoothed\": " << (cocone.isSmoothed() ? "true" : "false")
       << "},\n  \"outliers\": " << outliers.indices.size()
       << ",\n  \"outlier_indices\": " << jsonList(outliers.indices)
+      << ",\n  \"unmeshed_part_triangles\": "
+      << cocone.getReconstructionCounts().unmeshed_parts
       << ",\n  \"true_borders\": " << cocone.getReconstructionCounts().true_borders
       << ",\n  \"holes_filled\": " << filled.size()
       << ",\n  \"filled_hole_sizes\": " << jsonList(filled_sizes)

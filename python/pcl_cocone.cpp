@@ -477,6 +477,7 @@ toPython(cocone::Result& r,
   counts["walk_conflicts"] = c.walk_conflicts;
   counts["walk_reseeds"] = c.walk_reseeds;
   counts["repair"] = repair;
+  counts["unmeshed_parts"] = c.unmeshed_parts;
   counts["true_borders"] = c.true_borders;
   counts["holes_filled"] = c.holes_filled;
   counts["hole_triangles"] = c.hole_triangles;
@@ -574,6 +575,7 @@ eachCount(Counts& c, const F& f)
   f("repair.ribbon", c.repair.ribbon);
   f("repair.speck", c.repair.speck);
   f("repair.peeled", c.repair.peeled);
+  f("unmeshed_parts", c.unmeshed_parts);
   f("true_borders", c.true_borders);
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);

@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 
 #include "caller_ids.h"
+#include "disjoint_sets.h"
 #include "edge_sort.h"
 #include "points.h"
 #include "stopwatch.h"
@@ -100,6 +101,61 @@ plainCoconeMesh(const std::vector<Eigen::Vector3d>& points,
   return walkCandidates(points, candidates, none, threads, scratch).triangles;
 }
 
+/** The fewest points of a part the walk left unmeshed that the original Co-cone's
+ * mesh stands in for (unmeshedParts()): above the specks' and the outlier clusters'
+ * sizes (MIN_PIECE_VERTICES); the smallest true piece in the tests and the shared
+ * clouds has hundreds. */
+constexpr std::size_t MIN_UNMESHED_PART = 64;
+
+/** The points of the parts of the surface the walk left mostly unmeshed: the
+ * pieces co-cone triangles of the local spacing join the points into, of at least
+ * MIN_UNMESHED_PART points, fewer than half of which the walk's mesh uses. The
+ * flatness test found such a part undersampled nearly throughout (a knot's tube a
+ * few samples round, with noise of a third of the spacing: the walk leaves specks);
+ * what the original Co-cone makes of it is the best guess there is, and its holes
+ * are then closed like the walk's. Empty if there is none. */
+std::vector<std::uint8_t>
+unmeshedParts(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<double>& spacing,
+              const std::vector<CoconeTriangle>& cocone_triangles,
+              const std::vector<Triangle>& triangles)
+{
+  const std::size_t n = points.size();
+  std::vector<std::uint8_t> meshed(n, 0);
+  for (const auto& t : triangles)
+    meshed[t[0]] = meshed[t[1]] = meshed[t[2]] = 1;
+  if (2 * static_cast<std::size_t>(std::count(meshed.begin(), meshed.end(), 0)) <
+      MIN_UNMESHED_PART)
+    return std::vector<std::uint8_t>();
+  // Joined by the mesh's triangles too, whatever their length: each is then in one
+  // part, and taking out a part's leaves the others' fans whole.
+  detail::DisjointSets parts(n);
+  const auto join = [&](const auto& corners) {
+    parts.unite(corners[0], corners[1]);
+    parts.unite(corners[0], corners[2]);
+  };
+  for (const auto& t : cocone_triangles)
+    if (detail::triangleWithinReach(points, spacing, detail::FAR_NEIGHBOUR, t.v))
+      join(t.v);
+  for (const auto& t : triangles)
+    join(t);
+  // Per part (its root): its points, and those the mesh uses.
+  std::vector<std::size_t> size(n, 0), used(n, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const int root = parts.find(static_cast<int>(v));
+    ++size[root];
+    used[root] += meshed[v];
+  }
+  std::vector<std::uint8_t> region(n, 0);
+  bool any = false;
+  for (std::size_t v = 0; v < n; ++v) {
+    const int root = parts.find(static_cast<int>(v));
+    if (size[root] >= MIN_UNMESHED_PART && 2 * used[root] < size[root])
+      any = region[v] = 1;
+  }
+  return any ? region : std::vector<std::uint8_t>();
+}
+
 /** Rings of co-cone and mesh triangles around the open parts that the original
  * Co-cone's mesh is made over. */
 constexpr int PLAIN_COCONE_RINGS = 2;
@@ -163,6 +219,28 @@ reconstruct(Triangulation& dt,
                                      &incidences);
   }
   counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size(), &incidences);
+  if (parameters.fill_undersampled_holes && !spacing.empty()) {
+    const std::vector<std::uint8_t> unmeshed =
+        unmeshedParts(dt.points, spacing, cells.triangles, result.triangles);
+    if (!unmeshed.empty()) {
+      // The walk's triangles there (all their corners in the part) make way for
+      // the Co-cone's over the whole part: the mesh stays an oriented manifold.
+      std::vector<std::uint8_t> replaced(result.triangles.size(), 0);
+      for (std::size_t t = 0; t < result.triangles.size(); ++t)
+        replaced[t] = unmeshed[result.triangles[t][0]];
+      incidences.remove(replaced);
+      std::size_t kept = 0;
+      for (std::size_t t = 0; t < result.triangles.size(); ++t)
+        if (!replaced[t])
+          result.triangles[kept++] = result.triangles[t];
+      result.triangles.resize(kept);
+      const std::vector<Triangle> parts =
+          plainCoconeMesh(dt.points, cells, unmeshed, threads);
+      result.triangles.insert(result.triangles.end(), parts.begin(), parts.end());
+      incidences.add(result.triangles, kept);
+      counts.unmeshed_parts = parts.size();
+    }
+  }
   // The borders, in vertex ids (neither the order of the triangles nor the corner
   // each starts at, both set below, matters to them).
   result.border_loops = boundaryLoops(incidences, dt.points.size());

@@ -130,6 +130,7 @@ add(ReconstructionCounts& a, const ReconstructionCounts& b)
   a.repair.ribbon += b.repair.ribbon;
   a.repair.speck += b.repair.speck;
   a.repair.peeled += b.repair.peeled;
+  a.unmeshed_parts += b.unmeshed_parts;
   a.true_borders += b.true_borders;
   a.holes_filled += b.holes_filled;
   a.hole_triangles += b.hole_triangles;

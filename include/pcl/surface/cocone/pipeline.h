@@ -103,6 +103,7 @@ struct ReconstructionCounts {
   std::size_t walk_conflicts = 0; ///< stage 7: triangles reached with both orientations
   std::size_t walk_reseeds = 0;   ///< stage 7: walks started after one per component
   RepairCounts repair;            ///< changes by the manifold repair
+  std::size_t unmeshed_parts = 0; ///< triangles of the Co-cone over unmeshed parts
   std::size_t true_borders = 0;   ///< border loops classified true borders, kept open
   std::size_t holes_filled = 0;   ///< undersampled holes closed
   std::size_t hole_triangles = 0; ///< triangles added to close them
