@@ -285,6 +285,10 @@ public:
   /** \brief Close the border loops that are undersampled holes, keep the true
    * borders open (the question the paper leaves open).
    *
+   * First, a part of the surface whose points the walk's mesh mostly leaves out
+   * (joined by co-cone triangles of the local spacing, at least 64 points, fewer
+   * than half in a triangle: the flatness test flagged it nearly all over, such as a
+   * tube a few samples round under noise) gets the original Co-cone's mesh instead.
    * After the reconstruction every border loop of up to 1,000 edges is closed when
    * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces (or,
    * up to 40 edges, over all triangles of its points) finds a patch whose new edges
