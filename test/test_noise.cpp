@@ -406,6 +406,33 @@ TEST(Noise, RangeViews)
   }
 }
 
+TEST(Noise, RangeViewsOfOtherClosedShapes)
+{
+  // As above on shapes with creases, two handles or uneven curvature, each with as
+  // many views as cover it (rangeViews()): one closed sheet with its genus.
+  struct Case {
+    Surface surface;
+    int views;
+    long euler;
+  };
+  const Surface cube{"cube",
+                     [](const SampleOptions& o) { return cocone_test::cube(o); }};
+  const Surface genus2{"genus2",
+                       [](const SampleOptions& o) { return cocone_test::genus2(o); }};
+  const Surface ellipsoid{
+      "ellipsoid", [](const SampleOptions& o) { return cocone_test::ellipsoid(o); }};
+  for (const Case& c :
+       {Case{cube, 5, 2L}, Case{genus2, 9, -2L}, Case{ellipsoid, 5, 2L}}) {
+    const Sample s =
+        cocone_test::rangeViews(c.surface.make(options(30000)), c.views, 0.5, 7, 0.3);
+    SCOPED_TRACE(s.name);
+    ASSERT_TRUE(s.closed);
+    ASSERT_EQ(s.euler, c.euler);
+    const Result r = reconstruct(s.points);
+    expectClosed(s, r, c.euler);
+  }
+}
+
 TEST(Noise, RangeViewsOfAnOpenSurface)
 {
   // Four to six registered scans of the hemisphere (three do not cover it), half
@@ -429,6 +456,27 @@ TEST(Noise, RangeViewsOfAnOpenSurface)
       EXPECT_EQ(r.border_loops.size(), 1u);
       EXPECT_EQ(score.topology.euler, 1);
     }
+}
+
+TEST(Noise, RangeViewsOfOtherOpenSurfaces)
+{
+  // The open cylinder (two rims) and the sphere with three holes of 30 degrees in
+  // four and five registered scans: the rims are the only borders.
+  const Sample cylinder = cocone_test::rangeViews(
+      cocone_test::openCylinder(options(30000)), 4, 0.5, 7, 0.3);
+  const Sample holes = cocone_test::rangeViews(
+      cocone_test::sphereWithHoles(options(30000), 3, M_PI / 6.0), 5, 0.5, 7, 0.3);
+  for (const Sample& s : {cylinder, holes}) {
+    SCOPED_TRACE(s.name);
+    ASSERT_GT(s.boundary_loops, 0);
+    const Result r = reconstruct(s.points);
+    const auto score = cocone_test::scoreMesh(s, r);
+    std::printf("[ measured ] %s: %s\n", s.name.c_str(), score.str().c_str());
+    EXPECT_TRUE(score.topology.manifold());
+    EXPECT_EQ(score.topology.components, 1u);
+    EXPECT_EQ(r.border_loops.size(), std::size_t(s.boundary_loops));
+    EXPECT_EQ(score.topology.euler, s.euler);
+  }
 }
 
 TEST(Noise, SameOutputOnAnyThreads)
