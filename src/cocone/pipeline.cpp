@@ -228,12 +228,8 @@ reconstruct(Triangulation& dt,
       std::vector<std::uint8_t> replaced(result.triangles.size(), 0);
       for (std::size_t t = 0; t < result.triangles.size(); ++t)
         replaced[t] = unmeshed[result.triangles[t][0]];
-      incidences.remove(replaced);
-      std::size_t kept = 0;
-      for (std::size_t t = 0; t < result.triangles.size(); ++t)
-        if (!replaced[t])
-          result.triangles[kept++] = result.triangles[t];
-      result.triangles.resize(kept);
+      removeTriangles(result.triangles, replaced, &incidences);
+      const std::size_t kept = result.triangles.size();
       const std::vector<Triangle> parts =
           plainCoconeMesh(dt.points, cells, unmeshed, threads);
       result.triangles.insert(result.triangles.end(), parts.begin(), parts.end());
