@@ -1333,6 +1333,41 @@ TEST(HoleFilling, RangeGridDropoutsStayOpen)
   }
 }
 
+TEST(HoleFilling, GapRoundAnIslandStaysOpen)
+{
+  // A range grid of 120 x 120 samples with the scans' jitter whose samples between
+  // 8 and 12 spacings from the centre are missing: a ring-shaped dropout 4
+  // spacings wide round an island of about 200 samples, where a scan's view was
+  // occluded. Both rims are true borders (the sampling stops there): the ring's
+  // points seen through the hole (the island's) must not read as samples that
+  // split it into narrow openings. Truth: the outline, the ring's outer rim and
+  // the island's rim; two components, Euler 0 + 1.
+  constexpr int N = 120;
+  const double h = 1.0 / N;
+  for (const double noise : {0.15, 0.3}) {
+    SCOPED_TRACE(noise);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> gauss;
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) {
+        const double r = std::hypot(i - 60.0, j - 60.0);
+        if (r >= 8.0 && r < 12.0)
+          continue;
+        const double x = (i + 0.05 * gauss(rng)) * h, y = (j + 0.05 * gauss(rng)) * h;
+        points.emplace_back(
+            x, y, 0.15 * std::sin(3 * x) * std::cos(2 * y) + noise * h * gauss(rng));
+      }
+    const auto r = pcl::cocone::run(
+        points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+    const auto topology = pcl::cocone::analyzeMesh(r.polygons, points.size());
+    EXPECT_TRUE(topology.manifold());
+    EXPECT_EQ(topology.components, 2u);
+    EXPECT_EQ(r.border_loops.size(), 3u);
+    EXPECT_EQ(topology.euler, 1);
+  }
+}
+
 TEST(HoleFilling, NearlyTouchingSpheres)
 {
   // Two spheres of 5,000 random samples each, 2 spacings apart. The walk leaves

@@ -5,11 +5,15 @@
 
 #include <pcl/surface/cocone/border_classification.h>
 
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 #include "loop_plane.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace pcl {
 namespace cocone {
@@ -25,6 +29,29 @@ circumradius(const Eigen::Vector3d& a,
   if (twice_area <= 0.0)
     return std::numeric_limits<double>::infinity();
   return (b - c).norm() * (a - c).norm() * (a - b).norm() / (2.0 * twice_area);
+}
+
+/** The diameter of the widest disk centred in \a hole's polygon that holds none of
+ * its vertices nor of \a inner (plane coordinates): the largest Delaunay circle
+ * whose centre is inside the polygon. */
+double
+widestEmptyDisk(const detail::LoopPlane& hole,
+                const std::vector<Eigen::Vector2d>& inner)
+{
+  using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::vector<Kernel::Point_2> sites;
+  for (const auto* set : {&hole.polygon, &inner})
+    for (const auto& p : *set)
+      sites.emplace_back(p.x(), p.y());
+  const CGAL::Delaunay_triangulation_2<Kernel> dt(sites.begin(), sites.end());
+  double widest = 0.0;
+  for (const auto face : dt.finite_face_handles()) {
+    const Kernel::Point_2 c = CGAL::circumcenter(
+        face->vertex(0)->point(), face->vertex(1)->point(), face->vertex(2)->point());
+    if (hole.inside({c.x(), c.y()}))
+      widest = std::max(widest, CGAL::squared_distance(c, face->vertex(0)->point()));
+  }
+  return 2.0 * std::sqrt(widest);
 }
 
 } // namespace
@@ -64,40 +91,54 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
       }
     }
   }
-  // The vertices next to each loop (sharing a co-cone triangle with it),
-  // candidates for points in the hole.
-  std::vector<std::vector<int>> near(loops.size());
+  // The co-cone triangles' edges at each point, to find the points in each hole.
+  std::vector<int> first(points.size() + 1, 0), adjacent;
   for (const auto& t : cocone_triangles)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const int l = loop_of[t.v[j]];
-        if (j != i && l >= 0 && loop_of[t.v[i]] != l)
-          near[l].push_back(t.v[i]);
-      }
-
+    for (const int v : t.v)
+      first[v + 1] += 2;
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  adjacent.resize(first.back());
+  std::vector<int> next(first.begin(), first.end() - 1);
+  for (const auto& t : cocone_triangles)
+    for (int i = 0; i < 3; ++i) {
+      adjacent[next[t.v[i]]++] = t.v[(i + 1) % 3];
+      adjacent[next[t.v[i]]++] = t.v[(i + 2) % 3];
+    }
+  std::vector<int> seen(points.size(), -1), queue;
+  std::vector<Eigen::Vector2d> inner;
   for (std::size_t l = 0; l < loops.size(); ++l) {
     const auto& loop = loops[l];
     auto& radii = rim_radii[l];
     if (loop.size() < 3 || loop.size() > max_edges || radii.empty())
       continue;
     const detail::LoopPlane hole = detail::projectLoop(points, loop);
-    auto& candidates = near[l];
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()),
-                     candidates.end());
-    const auto inside = std::count_if(candidates.begin(), candidates.end(), [&](int v) {
-      return hole.contains(points[v]);
-    });
+    // The points in the hole: reached from the loop through co-cone triangles,
+    // each projecting into it.
+    const int stamp = static_cast<int>(l);
+    inner.clear();
+    queue.assign(loop.begin(), loop.end());
+    for (const int v : loop)
+      seen[v] = stamp;
+    for (std::size_t q = 0; q < queue.size(); ++q)
+      for (int a = first[queue[q]]; a < first[queue[q] + 1]; ++a) {
+        const int v = adjacent[a];
+        if (seen[v] != stamp && hole.contains(points[v])) {
+          seen[v] = stamp;
+          queue.push_back(v);
+          inner.push_back(hole.flat(points[v]));
+        }
+      }
     double area = 0.0, length = 0.0;
     for (std::size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
       const Eigen::Vector2d &a = hole.polygon[j], &b = hole.polygon[i];
       area += a.x() * b.y() - b.x() * a.y();
       length += (points[loop[i]] - points[loop[j]]).norm();
     }
-    // 4 A / P (A = |area| / 2), shared among the points inside: m points split the
-    // hole into about m + 1 openings, each 1 / sqrt(m + 1) as wide.
-    const double width =
-        2.0 * std::abs(area) / length / std::sqrt(static_cast<double>(inside + 1));
+    // 4 A / P (A = |area| / 2); with points in the hole, the widest opening they
+    // leave.
+    double width = 2.0 * std::abs(area) / length;
+    if (!inner.empty())
+      width = std::min(width, widestEmptyDisk(hole, inner));
     auto middle = radii.begin() + radii.size() / 2;
     std::nth_element(radii.begin(), middle, radii.end());
     border[l] = width > max_width * 2.0 * *middle;

@@ -29,12 +29,18 @@ namespace cocone {
  *
  * The hole's width is 4 A / P of the loop (the diameter of a round hole, twice
  * the width of a slit), A the area of its projection onto the loop's best-fit
- * plane, P its length, shared among the points in it: m points split it into
- * about m + 1 openings, each 1 / sqrt(m + 1) as wide. A point in the hole is a
- * vertex sharing a co-cone triangle with the loop that projects into it: a point
- * no triangle uses (the sampling goes on inside), or one of the mesh's when the
- * loop is no planar opening (it winds round a tip or a thin part and its
- * projection folds over the mesh); either way the filling's own tests decide.
+ * plane, P its length. With points in the hole, it is at most the diameter of the
+ * widest disk they and the loop leave empty there (the largest Delaunay circle
+ * centred in the projected hole): the opening the sampling really has. The points
+ * in the hole are those reached from the loop through co-cone triangles, each
+ * projecting into it: points no triangle uses (the sampling goes on inside), an
+ * island of the mesh that a gap rings, or the mesh's other side when the loop is
+ * no planar opening (it winds round a tip or a thin part and its projection folds
+ * over the mesh); either way the filling's own tests decide. Measured on the
+ * range scans: an occlusion gap ringing an island of the mesh read as many narrow
+ * openings under the earlier estimate (4 A / P shared among the m points, 1 /
+ * sqrt(m + 1) each) and was closed; on the closed meshes and the synthetic
+ * surfaces no loop's class changed.
  *
  * Assumes the sampling round a hole is locally even: a flat face that a mesh's
  * vertices sample only along its outline, wider than \a max_width of its rim's
