@@ -50,9 +50,14 @@ struct Parameters {
   bool fill_undersampled_holes = true;
   /** The longest edge of a hole's patch, in local spacings. Measured: the holes
    * noise tears where registered views overlap (one or two points missing) need
-   * 2.3 to 2.6; a patch of a round hole has an edge of 0.87 of its width, so a
-   * true hole 3.2 local spacings across or wider stays open. */
-  double hole_reach = 2.75;
+   * 2.3 to 2.6; on noisy closed meshes (vertex sets with noise 0.3 to 0.5 of the
+   * spacing, smoothed, some points set aside as outliers) patches of 3 to 4 close
+   * 10 to 17 more loops (2.75 left FinalBaseMesh, the bunny, the casting and the
+   * Power Crust knot 36 and 42 wrong loops at 0.3 and 0.5, 4.0 left 26 and 25),
+   * and the clean originalHead's last loop; at 6.0 two touching spheres bridge. A
+   * true hole is kept open by classifyBorderLoops() first: only one it takes for
+   * undersampled and whose patch has no edge beyond this reach closes. */
+  double hole_reach = 4.0;
   /** The widest undersampled hole with no sample in it, in diameters of the median
    * circumcircle of the triangles at its rim (classifyBorderLoops()): a wider empty
    * hole is where the sampling stops, a true border, and stays open. 0: every loop
