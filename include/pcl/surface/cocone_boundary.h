@@ -292,7 +292,7 @@ public:
    * After the reconstruction every border loop of up to 1,000 edges is closed when
    * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces (or,
    * up to 40 edges, over all triangles of its points) finds a patch whose new edges
-   * are all at most 2.75 local spacings long: an undersampled hole has samples all
+   * are all at most 4 local spacings long: an undersampled hole has samples all
    * around it that continue the surface at that spacing, where the sampled surface
    * really ends nothing is that close across. A loop left, and points in no
    * triangle, then get the original Co-cone's triangles there where those make a
