@@ -1279,6 +1279,33 @@ TEST(HoleFilling, TrueHolesFourSpacingsAcrossStayOpen)
   }
 }
 
+namespace {
+
+/** A range scanner's grid over a curved height field, N x N samples of the unit
+ * square with the sensor's jitter (0.05 of a spacing along the grid) and Gaussian
+ * noise of \a noise spacings along z; the samples (i, j) that \a missing names
+ * are left out. */
+template <typename Missing>
+std::vector<Eigen::Vector3d>
+rangeGrid(int N, double noise, std::uint64_t seed, const Missing& missing)
+{
+  const double h = 1.0 / N;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) {
+      if (missing(i, j))
+        continue;
+      const double x = (i + 0.05 * gauss(rng)) * h, y = (j + 0.05 * gauss(rng)) * h;
+      points.emplace_back(
+          x, y, 0.15 * std::sin(3 * x) * std::cos(2 * y) + noise * h * gauss(rng));
+    }
+  return points;
+}
+
+} // namespace
+
 TEST(HoleFilling, RangeGridDropoutsStayOpen)
 {
   // A range scanner's grid over a curved height field, 120 x 120 samples with
@@ -1289,7 +1316,6 @@ TEST(HoleFilling, RangeGridDropoutsStayOpen)
   // and the six dropouts as its loops. Without the classification the filling
   // closes two of the dropouts.
   constexpr int N = 120;
-  const double h = 1.0 / N;
   const int dropouts[][4] = {{20, 20, 3, 3},
                              {20, 60, 3, 4},
                              {60, 20, 2, 5},
@@ -1299,22 +1325,14 @@ TEST(HoleFilling, RangeGridDropoutsStayOpen)
   const int singles[][2] = {{30, 40}, {80, 90}, {100, 100}, {45, 10}};
   for (const double noise : {0.15, 0.3}) {
     SCOPED_TRACE(noise);
-    std::mt19937_64 rng(7);
-    std::normal_distribution<double> gauss;
-    std::vector<Eigen::Vector3d> points;
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) {
-        bool missing = false;
-        for (const auto& d : dropouts)
-          missing |= i >= d[0] && i < d[0] + d[2] && j >= d[1] && j < d[1] + d[3];
-        for (const auto& m : singles)
-          missing |= i == m[0] && j == m[1];
-        if (missing)
-          continue;
-        const double x = (i + 0.05 * gauss(rng)) * h, y = (j + 0.05 * gauss(rng)) * h;
-        points.emplace_back(
-            x, y, 0.15 * std::sin(3 * x) * std::cos(2 * y) + noise * h * gauss(rng));
-      }
+    const auto points = rangeGrid(N, noise, 7, [&](int i, int j) {
+      bool missing = false;
+      for (const auto& d : dropouts)
+        missing |= i >= d[0] && i < d[0] + d[2] && j >= d[1] && j < d[1] + d[3];
+      for (const auto& m : singles)
+        missing |= i == m[0] && j == m[1];
+      return missing;
+    });
     for (const double width : {pcl::cocone::Parameters().hole_width, 0.0}) {
       pcl::cocone::Parameters p;
       p.hole_width = width;
@@ -1342,22 +1360,12 @@ TEST(HoleFilling, GapRoundAnIslandStaysOpen)
   // points seen through the hole (the island's) must not read as samples that
   // split it into narrow openings. Truth: the outline, the ring's outer rim and
   // the island's rim; two components, Euler 0 + 1.
-  constexpr int N = 120;
-  const double h = 1.0 / N;
   for (const double noise : {0.15, 0.3}) {
     SCOPED_TRACE(noise);
-    std::mt19937_64 rng(11);
-    std::normal_distribution<double> gauss;
-    std::vector<Eigen::Vector3d> points;
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) {
-        const double r = std::hypot(i - 60.0, j - 60.0);
-        if (r >= 8.0 && r < 12.0)
-          continue;
-        const double x = (i + 0.05 * gauss(rng)) * h, y = (j + 0.05 * gauss(rng)) * h;
-        points.emplace_back(
-            x, y, 0.15 * std::sin(3 * x) * std::cos(2 * y) + noise * h * gauss(rng));
-      }
+    const auto points = rangeGrid(120, noise, 11, [](int i, int j) {
+      const double r = std::hypot(i - 60.0, j - 60.0);
+      return r >= 8.0 && r < 12.0;
+    });
     const auto r = pcl::cocone::run(
         points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
     const auto topology = pcl::cocone::analyzeMesh(r.polygons, points.size());

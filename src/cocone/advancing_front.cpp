@@ -13,12 +13,12 @@
 #include <CGAL/Advancing_front_surface_reconstruction.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "cocone_neighbours.h"
 #include "points.h"
 
 #include <algorithm>
 #include <array>
 #include <iterator>
-#include <numeric>
 
 namespace pcl {
 namespace cocone {
@@ -264,22 +264,9 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     vector_area[i] += normal;
     area[i] += normal.norm();
   }
-  // Per vertex its free co-cone neighbours, in compressed rows.
-  std::vector<std::size_t> first(n + 1, 0);
-  for (const auto& t : cocone_triangles)
-    for (const int a : t.v)
-      for (const int b : t.v)
-        first[a + 1] += piece[b] < 0;
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  std::vector<int> free_neighbour(first[n]);
-  {
-    std::vector<std::size_t> next(first.begin(), first.end() - 1);
-    for (const auto& t : cocone_triangles)
-      for (const int a : t.v)
-        for (const int b : t.v)
-          if (piece[b] < 0)
-            free_neighbour[next[a]++] = b;
-  }
+  // Per vertex its free co-cone neighbours.
+  const detail::CoconeNeighbours free_around = detail::coconeNeighbours(
+      cocone_triangles, n, [&](int b) { return piece[b] < 0; });
   std::vector<int> reached(n, -1);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     // At most the square of the longest loop's edges, as the piece.
@@ -288,8 +275,10 @@ closePiecesWithAdvancingFront(const std::vector<Eigen::Vector3d>& points,
     for (std::size_t k = 0;
          k < vertices.size() && static_cast<double>(vertices.size()) <= most;
          ++k)
-      for (std::size_t j = first[vertices[k]]; j < first[vertices[k] + 1]; ++j) {
-        const int b = free_neighbour[j];
+      for (std::size_t j = free_around.first[vertices[k]];
+           j < free_around.first[vertices[k] + 1];
+           ++j) {
+        const int b = free_around.neighbour[j];
         if (reached[b] != static_cast<int>(i)) {
           reached[b] = static_cast<int>(i);
           vertices.push_back(b);

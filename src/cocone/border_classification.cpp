@@ -8,12 +8,12 @@
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "cocone_neighbours.h"
 #include "loop_plane.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 
 namespace pcl {
 namespace cocone {
@@ -91,19 +91,9 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
       }
     }
   }
-  // The co-cone triangles' edges at each point, to find the points in each hole.
-  std::vector<int> first(points.size() + 1, 0), adjacent;
-  for (const auto& t : cocone_triangles)
-    for (const int v : t.v)
-      first[v + 1] += 2;
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  adjacent.resize(first.back());
-  std::vector<int> next(first.begin(), first.end() - 1);
-  for (const auto& t : cocone_triangles)
-    for (int i = 0; i < 3; ++i) {
-      adjacent[next[t.v[i]]++] = t.v[(i + 1) % 3];
-      adjacent[next[t.v[i]]++] = t.v[(i + 2) % 3];
-    }
+  // The co-cone triangles' corners at each point, to find the points in each hole.
+  const detail::CoconeNeighbours around = detail::coconeNeighbours(
+      cocone_triangles, points.size(), [](int) { return true; });
   std::vector<int> seen(points.size(), -1), queue;
   std::vector<Eigen::Vector2d> inner;
   for (std::size_t l = 0; l < loops.size(); ++l) {
@@ -120,8 +110,9 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     for (const int v : loop)
       seen[v] = stamp;
     for (std::size_t q = 0; q < queue.size(); ++q)
-      for (int a = first[queue[q]]; a < first[queue[q] + 1]; ++a) {
-        const int v = adjacent[a];
+      for (std::size_t a = around.first[queue[q]]; a < around.first[queue[q] + 1];
+           ++a) {
+        const int v = around.neighbour[a];
         if (seen[v] != stamp && hole.contains(points[v])) {
           seen[v] = stamp;
           queue.push_back(v);
