@@ -282,6 +282,35 @@ TEST(Noise, CoarseShapesAreNotSmoothedAway)
   }
 }
 
+TEST(Noise, NoisyCoarseTubeIsSmoothedWhereItMeshesBetter)
+{
+  // A knotted tube about ten samples round with noise of half a spacing: the
+  // smoothing moves the points partly as noise (kurtosis 2.2), partly alike (the
+  // tube drawn towards its axis), so the displacements do not tell. Both scales are
+  // reconstructed, and the smoothed one resolves more of the surface: measured, 0,
+  // 1, 0, 0 loops where the given points left 2, 3, 5, 2 (the mesh closed with
+  // Euler 0 on seeds 1 and 4; on seed 3 the tube is pinched, Euler 2).
+  std::size_t loops = 0;
+  for (const std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    SampleOptions o = options(8000, 0.5, 1.0, true);
+    o.seed = seed;
+    const Sample s = cocone_test::tube(o, 0.07);
+    SCOPED_TRACE(seed);
+    const Result r = reconstruct(s.points);
+    const auto m = cocone_test::scoreMesh(s, r);
+    std::printf("[ measured ] noisy tube, seed %d: %s, smoothed %d\n",
+                int(seed),
+                m.str().c_str(),
+                int(r.smoothed));
+    EXPECT_TRUE(r.smoothed);
+    EXPECT_TRUE(m.topology.manifold()) << m.str();
+    EXPECT_LE(m.loops, 1u) << m.str();
+    EXPECT_LT(m.max_distance, 2.5) << m.str(); // within the noise, 5 sigma
+    loops += m.loops;
+  }
+  EXPECT_LE(loops, 2u);
+}
+
 TEST(Noise, CleanCloudUnchanged)
 {
   // Clean samples read no noise and have no outlier: the pipeline gives what it
