@@ -640,14 +640,15 @@ handleNoise(Triangulation& dt,
 
   const Eigen::Vector3d offset = dt.offset;
   const auto resample = [&](std::vector<Eigen::Vector3d>&& positions,
-                            std::vector<int> vertex_of_input) {
+                            std::vector<int> vertex_of_input,
+                            std::string& error) {
     return retriangulate(std::move(positions),
                          offset,
                          noise.outlier,
                          std::move(vertex_of_input),
                          parameters,
                          threads,
-                         result.error);
+                         error);
   };
   const auto keep = [&](Sample&& sample) {
     dt = std::move(sample.dt);
@@ -659,9 +660,11 @@ handleNoise(Triangulation& dt,
   std::optional<Sample> alternative;
   std::vector<Eigen::Vector3d> kept;
   if (undecided) {
-    alternative = resample(std::move(smoothed), result.vertex_of_input);
-    if (!result.error.empty())
-      return std::nullopt;
+    // Smoothed points too few or collinear to triangulate leave the given ones.
+    std::string error;
+    alternative = resample(std::move(smoothed), result.vertex_of_input, error);
+    if (!error.empty())
+      alternative.reset();
     if (noise.outliers == 0)
       return alternative; // the triangulation stands for the given points
     kept = std::move(dt.points);
@@ -670,7 +673,7 @@ handleNoise(Triangulation& dt,
     kept = result.smoothed ? std::move(smoothed) : std::move(dt.points);
   cells = VoronoiCells();
   dt.release();
-  keep(resample(std::move(kept), std::move(result.vertex_of_input)));
+  keep(resample(std::move(kept), std::move(result.vertex_of_input), result.error));
   return alternative;
 }
 
