@@ -591,13 +591,15 @@ retriangulate(std::vector<Eigen::Vector3d> positions,
  * The displacements tell whether the smoothing took noise out or flattened a shape
  * too coarse or creased for the jets when they are distributed as noise is. When
  * they are not (a coarse surface with noise reads like one without: see
- * runStages()), \a dt and \a cells are those of the given points and the smoothed
- * points' sample is returned beside them; empty otherwise. Sets result.error if too
- * few points are left. */
+ * runStages()) and the stages include the reconstruction, \a dt and \a cells are
+ * those of the given points and the smoothed points' sample is returned beside
+ * them; empty otherwise (without the reconstruction the given points stay). Sets
+ * result.error if too few points are left. */
 std::optional<Sample>
 handleNoise(Triangulation& dt,
             VoronoiCells& cells,
             const Parameters& parameters,
+            Stages stages,
             Result& result,
             int threads)
 {
@@ -632,8 +634,9 @@ handleNoise(Triangulation& dt,
         result.noise_after_smoothing < SMOOTHED_NOISE_SHARE * noise.cloud_level;
     const double kurtosis = displacementKurtosis(dt.points, smoothed, noise.outlier);
     result.smoothed = reduced && kurtosis >= NOISE_KURTOSIS;
+    // Only meshes tell the scales apart (see runStages()).
     undecided = reduced && !result.smoothed && kurtosis >= ALIKE_KURTOSIS &&
-                parameters.boundary_detection;
+                parameters.boundary_detection && stages == Stages::RECONSTRUCTION;
   }
   if (!result.smoothed && !undecided && noise.outliers == 0)
     return std::nullopt; // a clean cloud: the triangulation stands
@@ -791,7 +794,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   result.timings.voronoi = clock.lap();
   std::optional<Sample> smoothed;
   if (parameters.noise_handling) {
-    smoothed = handleNoise(dt, cells, parameters, result, threads);
+    smoothed = handleNoise(dt, cells, parameters, stages, result, threads);
     if (!result.error.empty())
       return result;
   }
