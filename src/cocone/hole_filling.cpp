@@ -838,10 +838,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
     incidences.add(triangles, survivors);
     loops = boundaryLoops(incidences, num_vertices);
   }
-  std::vector<std::uint8_t> used(num_vertices, 0);
-  for (const auto& t : triangles)
-    for (const int v : t)
-      used[v] = 1;
+  const std::vector<std::uint8_t> used = usedVertices(triangles, num_vertices);
   const std::size_t after_patches = triangles.size();
 
   // The components of the other mesh over free vertices: a part the flatness test
@@ -922,10 +919,7 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
   if (loops.empty())
     return HoleFilling();
   const std::size_t n = points.size();
-  std::vector<std::uint8_t> used(n, 0);
-  for (const auto& t : triangles)
-    for (const int v : t)
-      used[v] = 1;
+  std::vector<std::uint8_t> used = usedVertices(triangles, n);
   // Neighbours through the co-cone triangles (compressed rows), made when a loop
   // needs them.
   std::vector<std::size_t> first;

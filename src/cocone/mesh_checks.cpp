@@ -344,5 +344,14 @@ borderVertices(const std::vector<Triangle>& triangles)
   return border;
 }
 
+std::vector<std::uint8_t>
+usedVertices(const std::vector<Triangle>& triangles, std::size_t num_vertices)
+{
+  std::vector<std::uint8_t> used(num_vertices, 0);
+  for (const auto& t : triangles)
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  return used;
+}
+
 } // namespace cocone
 } // namespace pcl

@@ -29,8 +29,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <new>
-#include <optional>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -122,9 +122,7 @@ unmeshedParts(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Triangle>& triangles)
 {
   const std::size_t n = points.size();
-  std::vector<std::uint8_t> meshed(n, 0);
-  for (const auto& t : triangles)
-    meshed[t[0]] = meshed[t[1]] = meshed[t[2]] = 1;
+  const std::vector<std::uint8_t> meshed = usedVertices(triangles, n);
   if (2 * static_cast<std::size_t>(std::count(meshed.begin(), meshed.end(), 0)) <
       MIN_UNMESHED_PART)
     return std::vector<std::uint8_t>();
@@ -349,10 +347,8 @@ reconstruct(Triangulation& dt,
         dropSpecks(result.triangles, dt.points.size(), MIN_PIECE_VERTICES, &incidences);
     if (counts.repair.speck > 0) {
       result.border_loops = boundaryLoops(incidences, dt.points.size());
-      std::vector<std::uint8_t> used(dt.points.size(), 0);
-      for (const auto& t : result.triangles)
-        for (const int v : t)
-          used[v] = 1;
+      const std::vector<std::uint8_t> used =
+          usedVertices(result.triangles, dt.points.size());
       const auto gone =
           std::remove_if(result.filled_holes.begin(),
                          result.filled_holes.end(),
@@ -593,9 +589,9 @@ retriangulate(std::vector<Eigen::Vector3d> positions,
  * they are not (a coarse surface with noise reads like one without: see
  * runStages()) and the stages include the reconstruction, \a dt and \a cells are
  * those of the given points and the smoothed points' sample is returned beside
- * them; empty otherwise (without the reconstruction the given points stay). Sets
+ * them; null otherwise (without the reconstruction the given points stay). Sets
  * result.error if too few points are left. */
-std::optional<Sample>
+std::unique_ptr<Sample>
 handleNoise(Triangulation& dt,
             VoronoiCells& cells,
             const Parameters& parameters,
@@ -604,7 +600,7 @@ handleNoise(Triangulation& dt,
             int threads)
 {
   if (cells.nearest.size() != dt.points.size())
-    return std::nullopt; // no neighbour lists (coplanar points): nothing to read
+    return nullptr; // no neighbour lists (coplanar points): nothing to read
   const std::vector<std::uint8_t> counted =
       countedVertices(parameters, result.vertex_of_input, result.vertices);
   const NoiseAnalysis noise = analyzeNoise(dt.points, cells.nearest, threads, counted);
@@ -639,7 +635,7 @@ handleNoise(Triangulation& dt,
                 parameters.boundary_detection && stages == Stages::RECONSTRUCTION;
   }
   if (!result.smoothed && !undecided && noise.outliers == 0)
-    return std::nullopt; // a clean cloud: the triangulation stands
+    return nullptr; // a clean cloud: the triangulation stands
 
   const Eigen::Vector3d offset = dt.offset;
   const auto resample = [&](std::vector<Eigen::Vector3d>&& positions,
@@ -660,12 +656,13 @@ handleNoise(Triangulation& dt,
     result.vertices = sample.vertices;
     result.offset = dt.offset;
   };
-  std::optional<Sample> alternative;
+  std::unique_ptr<Sample> alternative;
   std::vector<Eigen::Vector3d> kept;
   if (undecided) {
     // Smoothed points too few or collinear to triangulate leave the given ones.
     std::string error;
-    alternative = resample(std::move(smoothed), result.vertex_of_input, error);
+    alternative = std::make_unique<Sample>(
+        resample(std::move(smoothed), result.vertex_of_input, error));
     if (!error.empty())
       alternative.reset();
     if (noise.outliers == 0)
@@ -744,22 +741,13 @@ unresolvedVertices(const Parameters& parameters, const Result& result)
 {
   const std::vector<std::uint8_t> counted =
       countedVertices(parameters, result.vertex_of_input, result.vertices);
-  std::vector<std::uint8_t> resolved(result.vertices, 0);
-  for (const auto& t : result.triangles)
-    for (const int v : t)
-      resolved[v] = 1;
+  std::vector<std::uint8_t> resolved = usedVertices(result.triangles, result.vertices);
   for (const int v : borderVertices(result.triangles))
     resolved[v] = 0;
   std::size_t count = 0;
   for (std::size_t v = 0; v < result.vertices; ++v)
     count += !resolved[v] && (counted.empty() || counted[v]);
   return count;
-}
-
-double
-total(const Timings& t)
-{
-  return t.unique + t.delaunay + t.noise + t.voronoi + t.boundary + t.reconstruction;
 }
 
 Result
@@ -792,7 +780,7 @@ runStages(std::vector<Eigen::Vector3d>&& points,
 
   VoronoiCells cells = computePoles(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
-  std::optional<Sample> smoothed;
+  std::unique_ptr<Sample> smoothed;
   if (parameters.noise_handling) {
     smoothed = handleNoise(dt, cells, parameters, stages, result, threads);
     if (!result.error.empty())
@@ -821,16 +809,16 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   alternative.vertices = smoothed->vertices;
   alternative.offset = smoothed->dt.offset;
   alternative.smoothed = true;
-  const double before = total(result.timings);
   completeStages(dt, cells, parameters, stages, ids, threads, result);
+  const double given_ms = clock.lap();
   completeStages(
       smoothed->dt, smoothed->cells, parameters, stages, ids, threads, alternative);
+  const double smoothed_ms = clock.lap();
   const bool smoothing_wins =
       static_cast<double>(unresolvedVertices(parameters, alternative)) <=
       UNRESOLVED_SHARE * static_cast<double>(unresolvedVertices(parameters, result));
   Result& kept = smoothing_wins ? alternative : result;
-  const Result& other = smoothing_wins ? result : alternative;
-  kept.timings.noise += total(other.timings) - before; // the run at the other scale
+  kept.timings.noise += smoothing_wins ? given_ms : smoothed_ms; // the other scale's
   return std::move(kept);
 }
 

@@ -115,6 +115,10 @@ boundaryLoops(const EdgeIncidences& inc, std::size_t num_vertices);
 std::vector<int>
 borderVertices(const std::vector<Triangle>& triangles);
 
+/** \brief Per vertex (of \a num_vertices): whether a triangle uses it. */
+std::vector<std::uint8_t>
+usedVertices(const std::vector<Triangle>& triangles, std::size_t num_vertices);
+
 /** \brief Component id of every triangle (through shared edges), numbered in order
  * of the lowest triangle of each component. */
 std::vector<int>
