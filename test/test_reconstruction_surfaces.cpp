@@ -791,6 +791,65 @@ TEST(HoleFilling, ClosesHolesAsNarrowAsTheSpacingAndKeepsWiderOnes)
   }
 }
 
+TEST(HoleFilling, RimTrianglesSetTheReachWhereTheSamplingIsFinerAlongTheRim)
+{
+  // Rows one unit apart, sampled every 0.2 along them: the local spacing (the mean
+  // distance to the 6 nearest, 0.4) reads the rows, the triangles between them
+  // (circumdiameter 1.02) the sampling across. A hole two rows tall and two units
+  // wide needs an edge of 2 units (5 spacings): beyond a reach of 4 spacings, within
+  // 5 rim-triangle diameters. One 8 units wide needs edges of more than 5.66 (half
+  // its diagonal): beyond either.
+  using pcl::cocone::EdgeIncidences;
+  constexpr int columns = 61, rows = 13;
+  std::vector<Eigen::Vector3d> points;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i)
+      points.emplace_back(0.2 * i, 1.0 * j, 0.0);
+  const std::vector<double> spacing(points.size(), 0.4);
+  const auto id = [&](int i, int j) { return j * columns + i; };
+  struct Hole {
+    double x0, y0, x1, y1;
+    bool closed_by_rim;
+  };
+  for (const Hole& h :
+       {Hole{4.0, 3.0, 6.0, 5.0, true}, Hole{2.0, 2.0, 10.0, 10.0, false}}) {
+    SCOPED_TRACE(h.x1 - h.x0);
+    std::vector<pcl::cocone::Triangle> mesh;
+    for (int j = 0; j + 1 < rows; ++j)
+      for (int i = 0; i + 1 < columns; ++i) {
+        const double x = 0.2 * i + 0.1, y = j + 0.5; // the quad's centre
+        if (x > h.x0 && x < h.x1 && y > h.y0 && y < h.y1)
+          continue;
+        mesh.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+        mesh.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      }
+    for (const double rim_reach : {0.0, 5.0}) {
+      SCOPED_TRACE(rim_reach);
+      std::vector<pcl::cocone::Triangle> filled_mesh = mesh;
+      EdgeIncidences inc(filled_mesh);
+      auto loops = pcl::cocone::boundaryLoops(inc, points.size());
+      ASSERT_EQ(loops.size(), 2u); // the grid's outline and the hole
+      const auto filled =
+          pcl::cocone::fillUndersampledHoles(points,
+                                             spacing,
+                                             filled_mesh,
+                                             inc,
+                                             loops,
+                                             4.0,
+                                             1000,
+                                             {},
+                                             pcl::cocone::HoleWeight::DIHEDRAL_ANGLES,
+                                             rim_reach);
+      const auto topology = pcl::cocone::analyzeMesh(filled_mesh, points.size());
+      EXPECT_TRUE(topology.manifold());
+      EXPECT_EQ(inc.edges, EdgeIncidences(filled_mesh).edges);
+      const bool closed = h.closed_by_rim && rim_reach > 0.0;
+      EXPECT_EQ(filled.holes, closed ? 1u : 0u);
+      EXPECT_EQ(loops.size(), closed ? 1u : 2u);
+    }
+  }
+}
+
 TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
 {
   // A square grid of unit spacing cut along one diagonal, with a round hole, and

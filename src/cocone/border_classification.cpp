@@ -10,26 +10,15 @@
 
 #include "cocone_neighbours.h"
 #include "loop_plane.h"
+#include "points.h"
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace pcl {
 namespace cocone {
 
 namespace {
-
-double
-circumradius(const Eigen::Vector3d& a,
-             const Eigen::Vector3d& b,
-             const Eigen::Vector3d& c)
-{
-  const double twice_area = (b - a).cross(c - a).norm();
-  if (twice_area <= 0.0)
-    return std::numeric_limits<double>::infinity();
-  return (b - c).norm() * (a - c).norm() * (a - b).norm() / (2.0 * twice_area);
-}
 
 /** The diameter of the widest disk centred in \a hole's polygon that holds none of
  * its vertices nor of \a inner (plane coordinates): the largest Delaunay circle
@@ -86,7 +75,8 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     for (const int v : t) {
       const int l = loop_of[v];
       if (l >= 0 && l != last) { // counted once per loop
-        rim_radii[l].push_back(circumradius(points[t[0]], points[t[1]], points[t[2]]));
+        rim_radii[l].push_back(
+            detail::circumradius(points[t[0]], points[t[1]], points[t[2]]));
         last = l;
       }
     }

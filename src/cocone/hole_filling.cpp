@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <iterator>
 #include <limits>
 #include <numeric>
@@ -183,9 +184,11 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       double reach,
                       std::size_t max_edges,
                       const std::vector<std::uint8_t>& true_border,
-                      HoleWeight weight)
+                      HoleWeight weight,
+                      double rim_reach)
 {
   std::vector<int> hole;
+  double rim_longest2 = 0.0; // rim_reach in the hole's rim triangles, squared
   // Plausible: an edge of the hole, or a new edge within the reach and not in the
   // mesh yet (i, j positions in the hole).
   const auto plausible = [&](std::size_t i, std::size_t j) {
@@ -193,12 +196,25 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       std::swap(i, j);
     if (j == i + 1 || (i == 0 && j + 1 == hole.size()))
       return true;
-    return withinReach(points, spacing, reach, hole[i], hole[j]) &&
+    return (withinReach(points, spacing, reach, hole[i], hole[j]) ||
+            (points[hole[i]] - points[hole[j]]).squaredNorm() <= rim_longest2) &&
            incidences.find(hole[i], hole[j]) < 0;
   };
   // The mesh's triangle at the loop's edge ab.
   const auto beside = [&](int a, int b) -> const Triangle& {
     return triangles[incidences.triangle[incidences.first[incidences.find(a, b)]]];
+  };
+  std::vector<double> rim_radii;
+  const auto rim_longest = [&]() {
+    rim_radii.clear();
+    for (std::size_t i = 0; i < hole.size(); ++i) {
+      const Triangle& t = beside(hole[i], hole[(i + 1) % hole.size()]);
+      rim_radii.push_back(
+          detail::circumradius(points[t[0]], points[t[1]], points[t[2]]));
+    }
+    const auto middle = rim_radii.begin() + rim_radii.size() / 2;
+    std::nth_element(rim_radii.begin(), middle, rim_radii.end());
+    return rim_reach * 2.0 * *middle;
   };
 
   std::vector<Kernel::Point_3> polyline, third;
@@ -299,6 +315,11 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     // The hole runs against the loop, which has the mesh on its left: a triangle of
     // the hole's polygon with its corners in the hole's order faces as the mesh.
     hole.assign(loop.rbegin(), loop.rend());
+    rim_longest2 = 0.0;
+    if (rim_reach > 0.0) {
+      const double longest = rim_longest();
+      rim_longest2 = std::isfinite(longest) ? longest * longest : 0.0;
+    }
     return weight == HoleWeight::LEAST_PERIMETER ? least_perimeter_patch(patch)
                                                  : dihedral_patch(patch);
   };

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -59,6 +60,18 @@ meanNeighbourDistance(const std::vector<Eigen::Vector3d>& points,
   for (; kept < count && d[kept] <= bound; ++kept)
     sum += d[kept];
   return sum / kept;
+}
+
+/** The circumradius of triangle abc; infinite if it is degenerate. */
+inline double
+circumradius(const Eigen::Vector3d& a,
+             const Eigen::Vector3d& b,
+             const Eigen::Vector3d& c)
+{
+  const double twice_area = (b - a).cross(c - a).norm();
+  if (twice_area <= 0.0)
+    return std::numeric_limits<double>::infinity();
+  return (b - c).norm() * (a - c).norm() * (a - b).norm() / (2.0 * twice_area);
 }
 
 /** Whether edge ab is at most \a reach times the larger local spacing of its ends

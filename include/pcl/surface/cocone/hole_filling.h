@@ -59,6 +59,12 @@ enum class HoleWeight {
  * none of them in the mesh already. No new vertex; the patch faces as the loop's
  * triangles do, so the mesh stays an oriented 2-manifold.
  *
+ * Where the sampling is finer along the rim than across it (a crease sampled along
+ * its line, a vertex set that is dense round a face and sparse across it) the local
+ * spacing, a mean over the nearest samples, reads the fine direction; the triangles
+ * at the loop's rim read the coarse one. With \a rim_reach > 0 a new edge may also
+ * be as long as rim_reach times the median circumdiameter of those triangles.
+ *
  * Assumes that the spacing along a true border is not more than 1 / reach times the
  * width of what it encloses: a true hole narrower than about reach spacings is
  * taken for undersampling and closed.
@@ -76,6 +82,8 @@ enum class HoleWeight {
  * \param[in] weight which triangulation of a loop is tried: the pipeline tries the
  *                dihedral angles first and the least perimeter on the loops every
  *                other patch has left
+ * \param[in] rim_reach the longest new edge allowed besides, in diameters of the
+ *                loop's rim triangles (see above); 0: only \a reach
  */
 HoleFilling
 fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
@@ -86,7 +94,8 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       double reach,
                       std::size_t max_edges,
                       const std::vector<std::uint8_t>& true_border = {},
-                      HoleWeight weight = HoleWeight::DIHEDRAL_ANGLES);
+                      HoleWeight weight = HoleWeight::DIHEDRAL_ANGLES,
+                      double rim_reach = 0.0);
 
 /** \brief Close border loops, and cover points no triangle uses, with the triangles
  * another mesh of the same vertices has there: the original Co-cone's, every vertex
