@@ -850,6 +850,48 @@ TEST(HoleFilling, RimTrianglesSetTheReachWhereTheSamplingIsFinerAlongTheRim)
   }
 }
 
+TEST(HoleFilling, FlatSheetIsNotClosedByItsOtherSide)
+{
+  // A flat square grid: its outline's patch, whatever the reach, would lie on the
+  // grid itself, folded flat back onto it, a closed piece of no volume. A bent
+  // grid's outline (the corners raised out of the plane) is no such loop.
+  using pcl::cocone::EdgeIncidences;
+  constexpr int side = 6;
+  for (const double lift : {0.0, 2.0}) {
+    SCOPED_TRACE(lift);
+    std::vector<Eigen::Vector3d> points;
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i) {
+        // Jittered in the plane, so that no three outline points are collinear.
+        const double x = i - 2.5 + 0.2 * std::sin(7.0 * i + 3.0 * j),
+                     y = j - 2.5 + 0.2 * std::cos(5.0 * i + 11.0 * j);
+        points.emplace_back(x, y, lift * x * y / 6.25);
+      }
+    const std::vector<double> spacing(points.size(), 1.0);
+    std::vector<pcl::cocone::Triangle> mesh;
+    for (int j = 0; j + 1 < side; ++j)
+      for (int i = 0; i + 1 < side; ++i) {
+        const int a = j * side + i;
+        mesh.push_back({a, a + 1, a + side + 1});
+        mesh.push_back({a, a + side + 1, a + side});
+      }
+    EdgeIncidences inc(mesh);
+    auto loops = pcl::cocone::boundaryLoops(inc, points.size());
+    ASSERT_EQ(loops.size(), 1u);
+    const auto filled = pcl::cocone::fillUndersampledHoles(
+        points, spacing, mesh, inc, loops, 100.0, 1000);
+    EXPECT_TRUE(pcl::cocone::analyzeMesh(mesh, points.size()).manifold());
+    if (lift == 0.0) {
+      EXPECT_EQ(filled.holes, 0u);
+      EXPECT_EQ(loops.size(), 1u);
+    }
+    else {
+      EXPECT_EQ(filled.holes, 1u);
+      EXPECT_TRUE(loops.empty());
+    }
+  }
+}
+
 TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
 {
   // A square grid of unit spacing cut along one diagonal, with a round hole, and

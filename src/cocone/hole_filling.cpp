@@ -55,6 +55,13 @@ constexpr std::size_t LEAST_PERIMETER_EDGES = 128;
  * surface turns a half turn within a triangle or two (120 degrees left 4 of the 8
  * slits of a 10,000-point plate open, at 121). */
 constexpr double FOLD_COSINE = -0.866;
+/** The cosine beyond which a dihedral-angle patch lies back on the mesh beside the
+ * loop (folded flat, within a degree): it closes a sheet's outline with the sheet's
+ * other side, a closed piece of no volume (measured: the top and bottom of a box
+ * sampled densely along its edges and sparsely on its faces came out as two such
+ * pieces). Below a flat fold the dihedral patches are not refused: at 170 degrees the
+ * noisy closed meshes keep 1 to 2 loops more each where noise crumples a patch. */
+constexpr double DOUBLING_COSINE = -0.99985;
 
 /** A patch from another mesh may hold at most this many triangles per loop edge:
  * a disk of a loop's k edges with i inner vertices has k + 2i - 2 triangles. */
@@ -217,6 +224,38 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     return rim_reach * 2.0 * *middle;
   };
 
+  // A fold: at an edge of the patch the two triangles, the patch's or the mesh's
+  // beside the loop, face more than fold_cosine apart (or one is degenerate).
+  std::vector<std::pair<std::array<int, 2>, Eigen::Vector3d>> normal_at;
+  const auto normal = [&](const Triangle& t) {
+    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+  };
+  const auto folds = [&](const std::vector<Triangle>& patch,
+                         std::size_t first,
+                         double fold_cosine) {
+    normal_at.clear();
+    for (std::size_t i = 0; i < hole.size(); ++i) {
+      const int a = hole[i], b = hole[(i + 1) % hole.size()];
+      normal_at.push_back({edgeKey(a, b), normal(beside(a, b))});
+    }
+    for (std::size_t t = first; t < patch.size(); ++t)
+      for (int c = 0; c < 3; ++c)
+        normal_at.push_back(
+            {edgeKey(patch[t][c], patch[t][(c + 1) % 3]), normal(patch[t])});
+    std::sort(normal_at.begin(), normal_at.end(), [](const auto& x, const auto& y) {
+      return x.first < y.first;
+    });
+    for (std::size_t i = 0; i < normal_at.size(); ++i) {
+      const Eigen::Vector3d& n = normal_at[i].second;
+      if (!(n.squaredNorm() > 0.0) ||
+          (i + 1 < normal_at.size() && normal_at[i + 1].first == normal_at[i].first &&
+           !(n.dot(normal_at[i + 1].second) >
+             fold_cosine * n.norm() * normal_at[i + 1].second.norm())))
+        return true;
+    }
+    return false;
+  };
+
   std::vector<Kernel::Point_3> polyline, third;
   std::vector<LoopTriangle> found;
   const auto dihedral_patch = [&](std::vector<Triangle>& patch) {
@@ -228,46 +267,45 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       polyline.push_back(toCgal(points[a]));
       third.push_back(toCgal(points[thirdCorner(beside(a, b), a, b)]));
     }
-    found.clear();
-    CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
-        polyline,
-        third,
-        std::back_inserter(found),
-        CGAL::parameters::use_delaunay_triangulation(true).do_not_use_cubic_algorithm(
-            true));
-    const auto plausible_patch = [&]() {
+    const std::size_t first = patch.size();
+    // The patch CGAL found, if plausible and unfolded, appended to patch.
+    const auto take = [&]() {
       bool ok = found.size() == k - 2;
       for (const auto& t : found)
         ok = ok && plausible(t.v[0], t.v[1]) && plausible(t.v[1], t.v[2]) &&
              plausible(t.v[0], t.v[2]);
-      return ok;
+      if (!ok)
+        return false;
+      for (auto t : found) {
+        std::sort(t.v.begin(), t.v.end());
+        patch.push_back({hole[t.v[0]], hole[t.v[1]], hole[t.v[2]]});
+      }
+      if (!folds(patch, first, DOUBLING_COSINE))
+        return true;
+      patch.resize(first);
+      return false;
     };
-    bool closed = plausible_patch();
-    if (!closed && k <= CUBIC_SEARCH_EDGES) {
-      // The Delaunay faces of a loop round a corner or a crease may hold no short
-      // patch; all triangles of the loop's vertices may (Liepa's cubic search).
+    // The Delaunay faces of the loop's vertices first; where they hold no short
+    // patch (a loop round a corner or a crease), all triangles of its vertices
+    // (Liepa's cubic search) for loops of up to CUBIC_SEARCH_EDGES.
+    for (const bool delaunay : {true, false}) {
+      if (!delaunay && k > CUBIC_SEARCH_EDGES)
+        break;
       found.clear();
       CGAL::Polygon_mesh_processing::triangulate_hole_polyline(
           polyline,
           third,
           std::back_inserter(found),
-          CGAL::parameters::use_delaunay_triangulation(false));
-      closed = plausible_patch();
+          CGAL::parameters::use_delaunay_triangulation(delaunay)
+              .do_not_use_cubic_algorithm(delaunay));
+      if (take())
+        return true;
     }
-    if (closed)
-      for (auto t : found) {
-        std::sort(t.v.begin(), t.v.end());
-        patch.push_back({hole[t.v[0]], hole[t.v[1]], hole[t.v[2]]});
-      }
-    return closed;
+    return false;
   };
 
   std::vector<std::uint8_t> edge_ok;
   detail::LeastPerimeterScratch scratch;
-  std::vector<std::pair<std::array<int, 2>, Eigen::Vector3d>> normal_at;
-  const auto normal = [&](const Triangle& t) {
-    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
-  };
   const auto least_perimeter_patch = [&](std::vector<Triangle>& patch) {
     const std::size_t k = hole.size();
     if (k > LEAST_PERIMETER_EDGES)
@@ -282,32 +320,10 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     const std::size_t first = patch.size();
     if (!detail::leastPerimeterTriangulation(points, hole, valid, patch, scratch))
       return false;
-    // No fold: at every edge the two triangles, the patch's or the mesh's beside
-    // the loop, face within FOLD_COSINE of each other.
-    normal_at.clear();
-    for (std::size_t i = 0; i < k; ++i) {
-      const int a = hole[i], b = hole[(i + 1) % k];
-      normal_at.push_back({edgeKey(a, b), normal(beside(a, b))});
-    }
-    for (std::size_t t = first; t < patch.size(); ++t)
-      for (int c = 0; c < 3; ++c)
-        normal_at.push_back(
-            {edgeKey(patch[t][c], patch[t][(c + 1) % 3]), normal(patch[t])});
-    std::sort(normal_at.begin(), normal_at.end(), [](const auto& x, const auto& y) {
-      return x.first < y.first;
-    });
-    bool folds = false;
-    for (std::size_t i = 0; i < normal_at.size() && !folds; ++i) {
-      const Eigen::Vector3d& n = normal_at[i].second;
-      folds =
-          !(n.squaredNorm() > 0.0) ||
-          (i + 1 < normal_at.size() && normal_at[i + 1].first == normal_at[i].first &&
-           !(n.dot(normal_at[i + 1].second) >
-             FOLD_COSINE * n.norm() * normal_at[i + 1].second.norm()));
-    }
-    if (folds)
-      patch.resize(first);
-    return !folds;
+    if (!folds(patch, first, FOLD_COSINE))
+      return true;
+    patch.resize(first);
+    return false;
   };
 
   const auto patch_of = [&](const std::vector<int>& loop,

@@ -59,6 +59,10 @@ enum class HoleWeight {
  * none of them in the mesh already. No new vertex; the patch faces as the loop's
  * triangles do, so the mesh stays an oriented 2-manifold.
  *
+ * A patch folded flat back onto the mesh beside the loop (within a degree) is
+ * refused: it would close a sheet's outline with the sheet's other side, a closed
+ * piece of no volume.
+ *
  * Where the sampling is finer along the rim than across it (a crease sampled along
  * its line, a vertex set that is dense round a face and sparse across it) the local
  * spacing, a mean over the nearest samples, reads the fine direction; the triangles
