@@ -63,7 +63,9 @@ struct Parameters {
    * hole is where the sampling stops, a true border, and stays open. 0: every loop
    * may be filled. Measured: on an even grid one missing sample reads 1.4, two by
    * two 2.1, three by three 2.8; the holes noise tears where registered views
-   * overlap up to about 2.4 (at 2.0, 3 of 12 such test clouds kept one). */
+   * overlap up to about 2.4 (at 2.0, 3 of 12 such test clouds kept one). The last
+   * Delaunay patches may have edges twice as long, in the same unit, where the
+   * local spacing is finer (fillUndersampledHoles()'s rim_reach). */
   double hole_width = 2.5;
   /** Refine and fair the patches of the holes closed (refineFilledHoles()): new
    * vertices inside them, a smooth surface there; false: no new vertex. */
