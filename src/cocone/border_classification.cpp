@@ -120,9 +120,7 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     double width = 2.0 * std::abs(area) / length;
     if (!inner.empty())
       width = std::min(width, widestEmptyDisk(hole, inner));
-    auto middle = radii.begin() + radii.size() / 2;
-    std::nth_element(radii.begin(), middle, radii.end());
-    border[l] = width > max_width * 2.0 * *middle;
+    border[l] = width > max_width * detail::rimDiameter(radii);
   }
   return border;
 }

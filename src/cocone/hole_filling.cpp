@@ -195,7 +195,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                       double rim_reach)
 {
   std::vector<int> hole;
-  double rim_longest2 = 0.0; // rim_reach in the hole's rim triangles, squared
+  double rim_longest2 = 0.0; // rim_reach in the hole's rim diameters, squared
   // Plausible: an edge of the hole, or a new edge within the reach and not in the
   // mesh yet (i, j positions in the hole).
   const auto plausible = [&](std::size_t i, std::size_t j) {
@@ -211,17 +211,21 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
   const auto beside = [&](int a, int b) -> const Triangle& {
     return triangles[incidences.triangle[incidences.first[incidences.find(a, b)]]];
   };
+  // rim_longest2 for the hole: the rim diameter of the mesh's triangles at its edges.
   std::vector<double> rim_radii;
-  const auto rim_longest = [&]() {
+  const auto set_rim_longest = [&]() {
+    rim_longest2 = 0.0;
+    if (!(rim_reach > 0.0))
+      return;
     rim_radii.clear();
     for (std::size_t i = 0; i < hole.size(); ++i) {
       const Triangle& t = beside(hole[i], hole[(i + 1) % hole.size()]);
       rim_radii.push_back(
           detail::circumradius(points[t[0]], points[t[1]], points[t[2]]));
     }
-    const auto middle = rim_radii.begin() + rim_radii.size() / 2;
-    std::nth_element(rim_radii.begin(), middle, rim_radii.end());
-    return rim_reach * 2.0 * *middle;
+    const double longest = rim_reach * detail::rimDiameter(rim_radii);
+    if (std::isfinite(longest))
+      rim_longest2 = longest * longest;
   };
 
   // A fold: at an edge of the patch the two triangles, the patch's or the mesh's
@@ -331,11 +335,7 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     // The hole runs against the loop, which has the mesh on its left: a triangle of
     // the hole's polygon with its corners in the hole's order faces as the mesh.
     hole.assign(loop.rbegin(), loop.rend());
-    rim_longest2 = 0.0;
-    if (rim_reach > 0.0) {
-      const double longest = rim_longest();
-      rim_longest2 = std::isfinite(longest) ? longest * longest : 0.0;
-    }
+    set_rim_longest();
     return weight == HoleWeight::LEAST_PERIMETER ? least_perimeter_patch(patch)
                                                  : dihedral_patch(patch);
   };

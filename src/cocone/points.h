@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -72,6 +73,17 @@ circumradius(const Eigen::Vector3d& a,
   if (twice_area <= 0.0)
     return std::numeric_limits<double>::infinity();
   return (b - c).norm() * (a - c).norm() * (a - b).norm() / (2.0 * twice_area);
+}
+
+/** The diameter of the median circumcircle of \a radii (circumradii of the triangles
+ * at a loop's rim, reordered here): the scale of the sampling round a hole, which
+ * classifyBorderLoops() and fillUndersampledHoles() measure it in. */
+inline double
+rimDiameter(std::vector<double>& radii)
+{
+  const auto middle = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
+  std::nth_element(radii.begin(), middle, radii.end());
+  return 2.0 * *middle;
 }
 
 /** Whether edge ab is at most \a reach times the larger local spacing of its ends
