@@ -481,6 +481,7 @@ toPython(cocone::Result& r,
   counts["true_borders"] = c.true_borders;
   counts["holes_filled"] = c.holes_filled;
   counts["hole_triangles"] = c.hole_triangles;
+  counts["handles_cut"] = c.handles_cut;
 
   py::dict& report = out.report;
   report["stages"] = stages == cocone::Stages::RECONSTRUCTION ? "reconstruction"
@@ -579,6 +580,7 @@ eachCount(Counts& c, const F& f)
   f("true_borders", c.true_borders);
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);
+  f("handles_cut", c.handles_cut);
 }
 
 template <typename Timings, typename F>

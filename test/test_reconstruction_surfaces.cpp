@@ -5,6 +5,7 @@
  * Reconstruction (stages 1-7) on surfaces with known topology.
  */
 
+#include <pcl/surface/cocone/handle_removal.h>
 #include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
@@ -889,6 +890,87 @@ TEST(HoleFilling, FlatSheetIsNotClosedByItsOtherSide)
       EXPECT_EQ(filled.holes, 1u);
       EXPECT_TRUE(loops.empty());
     }
+  }
+}
+
+namespace {
+
+/** A torus triangulated as a grid of \a around x \a along vertices (the tube's
+ * circumference, the ring's), each quad split the same way: an oriented closed
+ * mesh of genus 1, its meridians cycles of \a around edges. */
+void
+gridTorus(int around,
+          int along,
+          std::vector<Eigen::Vector3d>& points,
+          std::vector<pcl::cocone::Triangle>& mesh)
+{
+  const double pi = std::acos(-1.0), ring = 0.2 * along, tube = 0.2 * around;
+  points.clear();
+  mesh.clear();
+  for (int i = 0; i < along; ++i)
+    for (int j = 0; j < around; ++j) {
+      // Jittered, so that no three vertices are collinear.
+      const double theta = 2.0 * pi * (i + 0.1 * std::sin(3.0 * i + 7.0 * j)) / along,
+                   phi = 2.0 * pi * (j + 0.1 * std::cos(5.0 * i + 2.0 * j)) / around;
+      points.emplace_back((ring + tube * std::cos(phi)) * std::cos(theta),
+                          (ring + tube * std::cos(phi)) * std::sin(theta),
+                          tube * std::sin(phi));
+    }
+  const auto id = [&](int i, int j) {
+    return ((i + along) % along) * around + (j + around) % around;
+  };
+  for (int i = 0; i < along; ++i)
+    for (int j = 0; j < around; ++j) {
+      mesh.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      mesh.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+}
+
+} // namespace
+
+TEST(HandleCutting, HandleShortBothWaysIsCutAndTubesAreKept)
+{
+  // A handle with 3 samples round it and 8 along: no sample resolves it, cut (the
+  // torus becomes a sphere). With 120 along it is a coarse tube (its meridians are
+  // short, its way round long), and with 6 round a tunnel the sample resolves:
+  // both kept. A hole elsewhere stays as it is.
+  using pcl::cocone::EdgeIncidences;
+  struct Case {
+    int around, along;
+    bool hole;
+    std::size_t cut;
+  };
+  for (const Case c : {Case{3, 8, false, 1},
+                       Case{3, 8, true, 1},
+                       Case{3, 120, false, 0},
+                       Case{6, 8, false, 0}}) {
+    SCOPED_TRACE(std::to_string(c.around) + " round, " + std::to_string(c.along) +
+                 " along" + (c.hole ? ", a hole" : ""));
+    std::vector<Eigen::Vector3d> points;
+    std::vector<pcl::cocone::Triangle> mesh;
+    gridTorus(c.around, c.along, points, mesh);
+    if (c.hole)
+      mesh.erase(mesh.begin() + 4 * c.around, mesh.begin() + 4 * c.around + 2);
+    const auto before = pcl::cocone::analyzeMesh(mesh, points.size());
+    const auto loops = pcl::cocone::boundaryLoops(mesh, points.size());
+    std::vector<std::vector<pcl::cocone::Triangle>> results;
+    for (const int threads : {1, 2}) {
+      std::vector<pcl::cocone::Triangle> cut_mesh = mesh;
+      EdgeIncidences inc(cut_mesh);
+      EXPECT_EQ(pcl::cocone::cutShortHandles(
+                    points, cut_mesh, inc, pcl::cocone::MIN_TUNNEL_SAMPLES, threads),
+                c.cut);
+      const auto after = pcl::cocone::analyzeMesh(cut_mesh, points.size());
+      EXPECT_TRUE(after.manifold());
+      EXPECT_EQ(after.vertices, points.size()); // every vertex still in the mesh
+      EXPECT_EQ(after.components, 1u);
+      EXPECT_EQ(after.euler, before.euler + 2 * static_cast<long>(c.cut));
+      // The borders unchanged, and the incidences those of the triangles.
+      EXPECT_EQ(pcl::cocone::boundaryLoops(inc, points.size()), loops);
+      EXPECT_EQ(inc.edges, EdgeIncidences(cut_mesh).edges);
+      results.push_back(std::move(cut_mesh));
+    }
+    EXPECT_EQ(results[0], results[1]);
   }
 }
 

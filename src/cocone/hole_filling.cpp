@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 
 #include "least_perimeter.h"
+#include "local_mesh.h"
 #include "loop_plane.h"
 #include "points.h"
 
@@ -344,87 +345,6 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
 
 namespace {
 
-/** The oriented manifold mesh that fillHolesFromMesh() changes: triangles taken out
- * are marked dead (the list and its incidences are brought up to date once, at the
- * end), each vertex knows its triangles. */
-class LocalMesh {
-public:
-  LocalMesh(std::vector<Triangle>& triangles, std::size_t num_vertices)
-  : triangles_(triangles)
-  , dead_(triangles.size(), 0)
-  , star_(num_vertices)
-  , uses_(num_vertices, 0)
-  {
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      for (const int v : triangles[t]) {
-        star_[v].push_back(static_cast<int>(t));
-        ++uses_[v];
-      }
-  }
-
-  const std::vector<Triangle>&
-  triangles() const
-  {
-    return triangles_;
-  }
-  const std::vector<std::uint8_t>&
-  dead() const
-  {
-    return dead_;
-  }
-  /** The live triangles at vertex v. */
-  template <typename Body>
-  void
-  forStar(int v, const Body& body) const
-  {
-    for (const int t : star_[v])
-      if (!dead_[t])
-        body(t);
-  }
-  /** Number of live triangles using vertex v. */
-  int
-  uses(int v) const
-  {
-    return uses_[v];
-  }
-  /** The live triangle that traverses the directed edge a -> b, or -1. */
-  int
-  traversing(int a, int b) const
-  {
-    int found = -1;
-    forStar(a, [&](int t) {
-      for (int c = 0; c < 3; ++c)
-        if (triangles_[t][c] == a && triangles_[t][(c + 1) % 3] == b)
-          found = t;
-    });
-    return found;
-  }
-  void
-  kill(int t)
-  {
-    dead_[t] = 1;
-    for (const int v : triangles_[t])
-      --uses_[v];
-  }
-  void
-  add(const Triangle& t)
-  {
-    const int id = static_cast<int>(triangles_.size());
-    triangles_.push_back(t);
-    dead_.push_back(0);
-    for (const int v : t) {
-      star_[v].push_back(id);
-      ++uses_[v];
-    }
-  }
-
-private:
-  std::vector<Triangle>& triangles_;
-  std::vector<std::uint8_t> dead_;
-  std::vector<std::vector<int>> star_;
-  std::vector<int> uses_;
-};
-
 using DirectedEdge = std::array<int, 2>;
 
 /** Euler characteristic V - E + F of the triangles \a ids of \a triangles. */
@@ -480,7 +400,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   };
   const EdgeIncidences theirs(other);
   const std::size_t before = triangles.size();
-  LocalMesh mesh(triangles, num_vertices);
+  detail::LocalMesh mesh(triangles, num_vertices);
   std::vector<std::uint8_t> taken(other.size(), 0);
   std::vector<int> in_patch(other.size(), -1), in_band(before, -1);
   int patch_stamp = -1, band_stamp = -1;
@@ -859,20 +779,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
     }
   }
   if (changed) {
-    // Out with the triangles taken out, in with the patches.
-    std::vector<std::uint8_t> dropped(mesh.dead().begin(),
-                                      mesh.dead().begin() + before);
-    incidences.remove(dropped);
-    std::vector<Triangle> kept;
-    kept.reserve(triangles.size());
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      if (!mesh.dead()[t])
-        kept.push_back(triangles[t]);
-    std::size_t survivors = 0;
-    for (std::size_t t = 0; t < before; ++t)
-      survivors += !mesh.dead()[t];
-    triangles = std::move(kept);
-    incidences.add(triangles, survivors);
+    mesh.commit(before, incidences);
     loops = boundaryLoops(incidences, num_vertices);
   }
   const std::vector<std::uint8_t> used = usedVertices(triangles, num_vertices);

@@ -7,6 +7,7 @@
 #include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/candidates.h>
 #include <pcl/surface/cocone/complex.h>
+#include <pcl/surface/cocone/handle_removal.h>
 #include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/hole_refinement.h>
 #include <pcl/surface/cocone/mesh_checks.h>
@@ -394,6 +395,10 @@ reconstruct(Triangulation& dt,
                 RIM_REACH_PER_WIDTH * parameters.hole_width);
     // Long narrow holes left, closed by the strip across them.
     patch_loops(HoleWeight::LEAST_PERIMETER, 0.0);
+    // Tunnels too narrow for any sample round them: the walk's, between sheets
+    // within the noise or a couple of spacings apart.
+    counts.handles_cut = cutShortHandles(
+        dt.points, result.triangles, incidences, MIN_TUNNEL_SAMPLES, threads);
     // The borders left through the samples on them.
     counts.repair.peeled =
         peelBorderSlivers(dt.points, result.triangles, incidences, result.border_loops);

@@ -133,6 +133,7 @@ add(ReconstructionCounts& a, const ReconstructionCounts& b)
   a.unmeshed_parts += b.unmeshed_parts;
   a.true_borders += b.true_borders;
   a.holes_filled += b.holes_filled;
+  a.handles_cut += b.handles_cut;
   a.hole_triangles += b.hole_triangles;
 }
 

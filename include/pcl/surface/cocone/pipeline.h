@@ -118,6 +118,7 @@ struct ReconstructionCounts {
   std::size_t true_borders = 0;   ///< border loops classified true borders, kept open
   std::size_t holes_filled = 0;   ///< undersampled holes closed
   std::size_t hole_triangles = 0; ///< triangles added to close them
+  std::size_t handles_cut = 0;    ///< handles no sampled tunnel explains, cut
 };
 
 /** \brief Wall-clock time of each stage, in milliseconds. */

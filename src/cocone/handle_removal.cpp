@@ -1,0 +1,606 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/handle_removal.h>
+#include <pcl/surface/cocone/mesh_checks.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include "least_perimeter.h"
+#include "local_mesh.h"
+#include "parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <tuple>
+#include <utility>
+
+namespace pcl {
+namespace cocone {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+/** How far from its short cycle a handle no sample resolves closes (its two sides
+ * meet), in triangles each way. Measured on the closed meshes with noise 0 to 0.5
+ * spacings: the spurious handles' sides meet 9 to 31 triangles round, counting both
+ * ways; the kitten's true handle, whose short cycle has 3 edges too, 1956. */
+constexpr int MAX_HANDLE_DEPTH = 32;
+
+/** Rounds of cuts at most: each takes the handles no earlier cut of the round
+ * touched. */
+constexpr int MAX_ROUNDS = 8;
+
+Kernel::Point_3
+toCgal(const Eigen::Vector3d& p)
+{
+  return {p.x(), p.y(), p.z()};
+}
+
+/** SplitMix64's output function: a fixed, well spread key per generator. */
+std::uint64_t
+splitMix(std::uint64_t x)
+{
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/** The vertices' edges (ids of the incidences), in CSR form. */
+struct VertexEdges {
+  std::vector<std::size_t> first;
+  std::vector<std::uint32_t> edge;
+
+  VertexEdges(const EdgeIncidences& inc, std::size_t num_vertices)
+  : first(num_vertices + 1, 0), edge(2 * inc.edges.size())
+  {
+    for (const auto& e : inc.edges) {
+      ++first[e[0] + 1];
+      ++first[e[1] + 1];
+    }
+    for (std::size_t v = 0; v < num_vertices; ++v)
+      first[v + 1] += first[v];
+    std::vector<std::size_t> next(first.begin(), first.end() - 1);
+    for (std::size_t e = 0; e < inc.edges.size(); ++e)
+      for (const int v : inc.edges[e])
+        edge[next[v]++] = static_cast<std::uint32_t>(e);
+  }
+};
+
+/** Per edge, the Z2 cohomology class of the mesh with each border loop capped by a
+ * disk, hashed to 64 bits: summed over a cycle's edges it is zero where the cycle
+ * separates the surface, and, but with odds of 2^-64, not zero where it does not.
+ * Tree-cotree (Eppstein 2003): the edges in neither a spanning forest of the
+ * vertices nor the spanning forest of the triangles and caps across the other edges
+ * are 2g per component, the generators; each gets a key, and an edge carries the
+ * keys of the generators whose dual loop (its own dual edge and the dual forest's
+ * path between its two sides) crosses it. Empty if no component has a handle.
+ * \a in_handled marks the vertices of the components that have one. */
+std::vector<std::uint64_t>
+cohomologyHashes(const EdgeIncidences& inc,
+                 const VertexEdges& at,
+                 std::size_t num_triangles,
+                 const std::vector<std::vector<int>>& loops,
+                 std::vector<std::uint8_t>& in_handled)
+{
+  const std::size_t num_vertices = at.first.size() - 1, num_edges = inc.edges.size();
+  // The dual forest's nodes: the triangles, then one cap per border loop.
+  std::vector<std::array<int, 2>> sides(num_edges);
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    if (inc.count(e) > 2)
+      return {};
+    sides[e] = {inc.triangle[inc.first[e]],
+                inc.count(e) == 2 ? inc.triangle[inc.first[e] + 1] : -1};
+  }
+  for (std::size_t l = 0; l < loops.size(); ++l)
+    for (std::size_t i = 0; i < loops[l].size(); ++i) {
+      const auto e = inc.find(loops[l][i], loops[l][(i + 1) % loops[l].size()]);
+      sides[e][1] = static_cast<int>(num_triangles + l);
+    }
+  // The vertices' spanning forest, breadth first; its components.
+  std::vector<std::uint8_t> in_tree(num_edges, 0);
+  std::vector<int> component(num_vertices, -1);
+  std::vector<int> queue;
+  int components = 0;
+  for (std::size_t s = 0; s < num_vertices; ++s) {
+    if (component[s] >= 0 || at.first[s] == at.first[s + 1])
+      continue;
+    component[s] = components;
+    queue.assign(1, static_cast<int>(s));
+    for (std::size_t q = 0; q < queue.size(); ++q)
+      for (std::size_t i = at.first[queue[q]]; i < at.first[queue[q] + 1]; ++i) {
+        const std::uint32_t e = at.edge[i];
+        const int w = inc.edges[e][0] == queue[q] ? inc.edges[e][1] : inc.edges[e][0];
+        if (component[w] < 0) {
+          component[w] = components;
+          in_tree[e] = 1;
+          queue.push_back(w);
+        }
+      }
+    ++components;
+  }
+  // The dual forest across the other edges, breadth first.
+  const std::size_t num_nodes = num_triangles + loops.size();
+  std::vector<std::size_t> first(num_nodes + 1, 0);
+  for (std::size_t e = 0; e < num_edges; ++e)
+    if (!in_tree[e]) {
+      ++first[sides[e][0] + 1];
+      ++first[sides[e][1] + 1];
+    }
+  for (std::size_t n = 0; n < num_nodes; ++n)
+    first[n + 1] += first[n];
+  std::vector<std::uint32_t> across(first.back());
+  {
+    std::vector<std::size_t> next(first.begin(), first.end() - 1);
+    for (std::size_t e = 0; e < num_edges; ++e)
+      if (!in_tree[e])
+        for (const int n : sides[e])
+          across[next[n]++] = static_cast<std::uint32_t>(e);
+  }
+  std::vector<int> parent_edge(num_nodes, -1), parent(num_nodes, -1);
+  std::vector<std::uint8_t> reached(num_nodes, 0), in_cotree(num_edges, 0);
+  std::vector<int> order;
+  order.reserve(num_nodes);
+  for (std::size_t s = 0; s < num_nodes; ++s) {
+    if (reached[s])
+      continue;
+    reached[s] = 1;
+    const std::size_t from = order.size();
+    order.push_back(static_cast<int>(s));
+    for (std::size_t q = from; q < order.size(); ++q)
+      for (std::size_t i = first[order[q]]; i < first[order[q] + 1]; ++i) {
+        const std::uint32_t e = across[i];
+        const int n = sides[e][0] == order[q] ? sides[e][1] : sides[e][0];
+        if (!reached[n]) {
+          reached[n] = 1;
+          in_cotree[e] = 1;
+          parent[n] = order[q];
+          parent_edge[n] = static_cast<int>(e);
+          order.push_back(n);
+        }
+      }
+  }
+  // The generators' keys, summed over each node's subtree: a cotree edge is on a
+  // generator's dual loop where one of the generator's sides is below it.
+  std::vector<std::uint64_t> hash(num_edges, 0), below(num_nodes, 0);
+  bool any = false;
+  in_handled.assign(num_vertices, 0);
+  std::vector<std::uint8_t> handled(static_cast<std::size_t>(components), 0);
+  for (std::size_t e = 0; e < num_edges; ++e)
+    if (!in_tree[e] && !in_cotree[e]) {
+      hash[e] = splitMix(e) | 1;
+      below[sides[e][0]] ^= hash[e];
+      below[sides[e][1]] ^= hash[e];
+      handled[component[inc.edges[e][0]]] = 1;
+      any = true;
+    }
+  if (!any)
+    return {};
+  for (auto n = order.rbegin(); n != order.rend(); ++n)
+    if (parent[*n] >= 0) {
+      hash[parent_edge[*n]] = below[*n];
+      below[parent[*n]] ^= below[*n];
+    }
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    in_handled[v] = component[v] >= 0 && handled[component[v]];
+  return hash;
+}
+
+/** A cycle of mesh edges, its vertices from the lowest id on, towards the lower of
+ * that vertex's two neighbours on it. */
+struct Cycle {
+  std::vector<int> vertices;
+  double length = 0.0;
+
+  bool
+  operator<(const Cycle& other) const
+  {
+    const std::size_t edges = vertices.size(), other_edges = other.vertices.size();
+    return std::tie(edges, length, vertices) <
+           std::tie(other_edges, other.length, other.vertices);
+  }
+};
+
+/** Per vertex, the shortest cycle through it of at most \a max_edges edges whose
+ * hash sum is not zero: two paths of a breadth-first tree from the vertex, leaving
+ * it by different edges, and an edge between their ends. The shortest
+ * non-separating cycle through a vertex is of that form for any shortest-path tree
+ * (Erickson and Har-Peled 2004), and a lasso's loop is found from its knot. */
+std::vector<Cycle>
+shortCycles(const std::vector<Eigen::Vector3d>& points,
+            const EdgeIncidences& inc,
+            const VertexEdges& at,
+            const std::vector<std::uint64_t>& hash,
+            const std::vector<std::uint8_t>& in_handled,
+            std::size_t max_edges,
+            int threads)
+{
+  const std::size_t num_vertices = at.first.size() - 1;
+  const int depth_limit = static_cast<int>(max_edges / 2);
+  // A cycle whose sum is not zero has an edge whose hash is not, and its vertices
+  // lie within depth_limit edges of that edge's ends: the seeds (on a fine mesh of
+  // a torus, the few thousand vertices along the dual loops of its two generators).
+  std::vector<std::uint8_t> seed(num_vertices, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (hash[e] != 0)
+      seed[inc.edges[e][0]] = seed[inc.edges[e][1]] = 1;
+  for (int ring = 0; ring < depth_limit; ++ring) {
+    std::vector<std::uint8_t> grown = seed;
+    for (const auto& e : inc.edges)
+      if (seed[e[0]] || seed[e[1]])
+        grown[e[0]] = grown[e[1]] = 1;
+    seed = std::move(grown);
+  }
+  const int parts = detail::partsFor(num_vertices, threads);
+  std::vector<std::vector<Cycle>> found(parts);
+  detail::forEachRange(
+      num_vertices, parts, [&](std::size_t begin, std::size_t end, int part) {
+        // Per ball vertex: its slot, depth, tree parent, first hop, hash and length.
+        struct Node {
+          int vertex, depth, parent, branch;
+          std::uint64_t hash;
+          double length;
+        };
+        std::vector<int> slot(num_vertices, -1);
+        std::vector<Node> ball;
+        for (std::size_t s = begin; s < end; ++s) {
+          if (!seed[s] || !in_handled[s])
+            continue;
+          ball.assign(1, {static_cast<int>(s), 0, -1, -1, 0, 0.0});
+          slot[s] = 0;
+          for (std::size_t q = 0; q < ball.size(); ++q) {
+            if (ball[q].depth == depth_limit)
+              continue;
+            const int x = ball[q].vertex;
+            for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+              const std::uint32_t e = at.edge[i];
+              const int w = inc.edges[e][0] == x ? inc.edges[e][1] : inc.edges[e][0];
+              if (slot[w] >= 0 || !in_handled[w])
+                continue;
+              slot[w] = static_cast<int>(ball.size());
+              ball.push_back({w,
+                              ball[q].depth + 1,
+                              static_cast<int>(q),
+                              q == 0 ? w : ball[q].branch,
+                              ball[q].hash ^ hash[e],
+                              ball[q].length + (points[w] - points[x]).norm()});
+            }
+          }
+          std::size_t best_edges = max_edges + 1;
+          double best_length = 0.0;
+          std::array<int, 2> best_ends{-1, -1};
+          for (std::size_t a = 0; a < ball.size(); ++a) {
+            const int x = ball[a].vertex;
+            for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+              const std::uint32_t e = at.edge[i];
+              const int w = inc.edges[e][0] == x ? inc.edges[e][1] : inc.edges[e][0];
+              const int b = slot[w];
+              if (b <= static_cast<int>(a) || ball[a].branch == ball[b].branch ||
+                  ball[b].parent == static_cast<int>(a) ||
+                  (ball[a].hash ^ ball[b].hash ^ hash[e]) == 0)
+                continue;
+              const std::size_t edges = static_cast<std::size_t>(ball[a].depth) +
+                                        static_cast<std::size_t>(ball[b].depth) + 1;
+              const double length =
+                  ball[a].length + ball[b].length + (points[w] - points[x]).norm();
+              if (edges < best_edges || (edges == best_edges && length < best_length)) {
+                best_edges = edges;
+                best_length = length;
+                best_ends = {static_cast<int>(a), b};
+              }
+            }
+          }
+          if (best_ends[0] >= 0) {
+            // The root, down the second path, back up the first.
+            Cycle cycle;
+            cycle.length = best_length;
+            auto& v = cycle.vertices;
+            for (int n = best_ends[1]; n > 0; n = ball[n].parent)
+              v.push_back(ball[n].vertex);
+            v.push_back(static_cast<int>(s));
+            std::reverse(v.begin(), v.end());
+            for (int n = best_ends[0]; n > 0; n = ball[n].parent)
+              v.push_back(ball[n].vertex);
+            std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
+            if (v[1] > v.back())
+              std::reverse(v.begin() + 1, v.end());
+            found[part].push_back(std::move(cycle));
+          }
+          for (const Node& n : ball)
+            slot[n.vertex] = -1;
+        }
+      });
+  std::vector<Cycle> cycles;
+  for (auto& f : found)
+    std::move(f.begin(), f.end(), std::back_inserter(cycles));
+  std::sort(cycles.begin(), cycles.end());
+  cycles.erase(std::unique(cycles.begin(),
+                           cycles.end(),
+                           [](const Cycle& a, const Cycle& b) {
+                             return a.vertices == b.vertices;
+                           }),
+               cycles.end());
+  return cycles;
+}
+
+/** How far round \a cycle its two sides meet: a breadth-first search from the
+ * triangle on each side of its first edge, across every edge but the cycle's, in
+ * turns, until the two meet; the triangles on the shortest way found from one side
+ * to the other. -1 if one side runs out first (the cycle separates) or neither
+ * meets the other within \a max_depth triangles of the cycle; so the cost is that
+ * of the smaller side or of the way round the handle, at most two balls of that
+ * radius. */
+int
+waySidesMeet(const detail::LocalMesh& mesh,
+             const std::vector<int>& cycle,
+             int max_depth,
+             std::vector<int>& depth)
+{
+  const std::size_t k = cycle.size();
+  const auto on_cycle = [&](int a, int b) {
+    for (std::size_t i = 0; i < k; ++i) {
+      const int c = cycle[i], d = cycle[(i + 1) % k];
+      if ((a == c && b == d) || (a == d && b == c))
+        return true;
+    }
+    return false;
+  };
+  // depth: 0 unreached, +d on the left at d - 1 triangles off, -d on the right.
+  depth.resize(mesh.triangles().size(), 0);
+  std::array<std::vector<int>, 2> queue{
+      std::vector<int>{mesh.traversing(cycle[0], cycle[1])},
+      std::vector<int>{mesh.traversing(cycle[1], cycle[0])}};
+  std::array<std::size_t, 2> head{0, 0};
+  int way = -1;
+  if (queue[0][0] >= 0 && queue[1][0] >= 0) {
+    depth[queue[0][0]] = 1;
+    depth[queue[1][0]] = -1;
+    for (int s = 0; way < 0; s ^= 1) {
+      if (head[s] == queue[s].size())
+        break;
+      const int t = queue[s][head[s]++];
+      const int d = std::abs(depth[t]);
+      if (d > max_depth)
+        break;
+      for (int c = 0; c < 3 && way < 0; ++c) {
+        const int a = mesh.triangles()[t][c], b = mesh.triangles()[t][(c + 1) % 3];
+        if (on_cycle(a, b))
+          continue;
+        const int n = mesh.traversing(b, a);
+        if (n < 0 || (depth[n] != 0 && (depth[n] > 0) == (s == 0)))
+          continue;
+        if (depth[n] != 0)
+          way = d + std::abs(depth[n]);
+        else {
+          depth[n] = s == 0 ? d + 1 : -(d + 1);
+          queue[s].push_back(n);
+        }
+      }
+    }
+  }
+  for (const auto& q : queue)
+    for (const int t : q)
+      if (t >= 0)
+        depth[t] = 0;
+  return way;
+}
+
+/** Cut \a mesh along \a cycle (directed): the triangles on its left, the fans of
+ * its vertices between its edges, taken out; the cycle and the band's outer loop
+ * closed by least-perimeter patches of their vertices. False, and the mesh
+ * unchanged, where the band is no annulus between the cycle and a simple loop of
+ * other vertices clear of the mesh's borders and of earlier cuts (\a touched), or a
+ * patch needs an edge the mesh has or a degenerate triangle. */
+bool
+cutAlong(const std::vector<Eigen::Vector3d>& points,
+         detail::LocalMesh& mesh,
+         const std::vector<int>& cycle,
+         std::vector<std::uint8_t>& touched,
+         detail::LeastPerimeterScratch& scratch)
+{
+  const std::size_t k = cycle.size();
+  std::vector<int> band;
+  for (std::size_t i = 0; i < k; ++i) {
+    const int v = cycle[i], prev = cycle[(i + k - 1) % k];
+    int to = cycle[(i + 1) % k];
+    for (int turns = 0;; ++turns) {
+      const int t = mesh.traversing(v, to);
+      if (t < 0 || turns > 64)
+        return false;
+      band.push_back(t);
+      const Triangle& tri = mesh.triangles()[t];
+      const int c =
+          static_cast<int>(std::find(tri.begin(), tri.end(), v) - tri.begin());
+      to = tri[(c + 2) % 3];
+      if (to == prev)
+        break;
+    }
+  }
+  std::sort(band.begin(), band.end());
+  band.erase(std::unique(band.begin(), band.end()), band.end());
+  const auto in_band = [&](int t) {
+    return t >= 0 && std::binary_search(band.begin(), band.end(), t);
+  };
+  // The band's boundary: its half-edges whose twin is outside it, each with one.
+  std::vector<std::array<int, 2>> rim;
+  for (const int t : band)
+    for (int c = 0; c < 3; ++c) {
+      const int a = mesh.triangles()[t][c], b = mesh.triangles()[t][(c + 1) % 3];
+      const int twin = mesh.traversing(b, a);
+      if (twin < 0)
+        return false; // a border
+      if (!in_band(twin))
+        rim.push_back({a, b});
+    }
+  const auto on_cycle = [&](int v) {
+    return std::find(cycle.begin(), cycle.end(), v) != cycle.end();
+  };
+  // The cycle's own edges, then the outer loop through the other vertices.
+  std::vector<int> outer;
+  for (std::size_t i = 0; i < k; ++i) {
+    const std::array<int, 2> own{cycle[i], cycle[(i + 1) % k]};
+    const auto it = std::find(rim.begin(), rim.end(), own);
+    if (it == rim.end())
+      return false;
+    rim.erase(it);
+  }
+  if (rim.size() < 3)
+    return false;
+  std::sort(rim.begin(), rim.end());
+  for (std::size_t i = 0; i + 1 < rim.size(); ++i)
+    if (rim[i][0] == rim[i + 1][0])
+      return false; // the band's outer boundary is not a simple loop
+  outer.push_back(rim[0][0]);
+  while (outer.size() <= rim.size()) {
+    const auto it =
+        std::lower_bound(rim.begin(), rim.end(), std::array<int, 2>{outer.back(), -1});
+    if (it == rim.end() || (*it)[0] != outer.back())
+      return false;
+    if ((*it)[1] == outer[0])
+      break;
+    outer.push_back((*it)[1]);
+  }
+  if (outer.size() != rim.size())
+    return false; // more than one outer loop
+  for (const int v : outer)
+    if (on_cycle(v) || touched[v])
+      return false;
+  for (const int v : cycle)
+    if (touched[v])
+      return false;
+  for (const int t : band)
+    for (const int v : mesh.triangles()[t])
+      if (!on_cycle(v) && std::find(outer.begin(), outer.end(), v) == outer.end())
+        return false; // a vertex inside the band would leave the mesh
+  for (const int t : band)
+    mesh.kill(t);
+  // Each loop closed in the direction of the band's half-edges on it, as the band's
+  // triangles ran: the patches face as the mesh.
+  std::vector<Triangle> patches;
+  bool closed = true;
+  for (const std::vector<int>* loop :
+       {&cycle, static_cast<const std::vector<int>*>(&outer)}) {
+    const std::size_t n = loop->size();
+    const auto valid = [&](std::size_t i, std::size_t m, std::size_t j) {
+      const auto new_edge = [&](std::size_t x, std::size_t y) {
+        const int a = (*loop)[x], b = (*loop)[y];
+        return y == x + 1 || (x == 0 && y == n - 1) ||
+               (mesh.traversing(a, b) < 0 && mesh.traversing(b, a) < 0);
+      };
+      return new_edge(i, m) && new_edge(m, j) && new_edge(i, j) &&
+             !CGAL::collinear(toCgal(points[(*loop)[i]]),
+                              toCgal(points[(*loop)[m]]),
+                              toCgal(points[(*loop)[j]]));
+    };
+    if (!detail::leastPerimeterTriangulation(points, *loop, valid, patches, scratch)) {
+      closed = false;
+      break;
+    }
+  }
+  if (!closed) {
+    for (const int t : band)
+      mesh.revive(t);
+    return false;
+  }
+  for (const Triangle& t : patches)
+    mesh.add(t);
+  for (const int v : cycle)
+    touched[v] = 1;
+  for (const int v : outer)
+    touched[v] = 1;
+  return true;
+}
+
+/** One round of cutShortHandles(): the candidates on the mesh as it is, each cut
+ * unless an earlier cut of the round touched it. */
+std::size_t
+cutRound(const std::vector<Eigen::Vector3d>& points,
+         std::vector<Triangle>& triangles,
+         EdgeIncidences& incidences,
+         std::size_t min_tunnel_samples,
+         int threads)
+{
+  const std::size_t num_vertices = points.size();
+  const std::vector<std::vector<int>> loops = boundaryLoops(incidences, num_vertices);
+  // Every component of genus 0 (the common case, a disk or a sphere with holes):
+  // V - E + F + loops = 2 per component, and nothing to cut.
+  std::size_t components = 0;
+  triangleComponents(incidences, triangles.size(), &components);
+  const std::vector<std::uint8_t> used = usedVertices(triangles, num_vertices);
+  const auto vertices = static_cast<long>(std::count(used.begin(), used.end(), 1));
+  if (vertices - static_cast<long>(incidences.edges.size()) +
+          static_cast<long>(triangles.size() + loops.size()) ==
+      2 * static_cast<long>(components))
+    return 0;
+  const VertexEdges at(incidences, num_vertices);
+  std::vector<std::uint8_t> in_handled;
+  const std::vector<std::uint64_t> hash =
+      cohomologyHashes(incidences, at, triangles.size(), loops, in_handled);
+  if (hash.empty())
+    return 0;
+  // Borders and what lies a ring off them are no place to cut (a cycle through a
+  // border's vertices may not separate the capped surface where it separates the
+  // mesh): the cycles keep off them, and a border vertex counts as touched.
+  std::vector<std::uint8_t> touched(num_vertices, 0);
+  for (const auto& loop : loops)
+    for (const int v : loop) {
+      touched[v] = 1;
+      in_handled[v] = 0;
+    }
+  const std::vector<Cycle> cycles = shortCycles(
+      points, incidences, at, hash, in_handled, min_tunnel_samples - 1, threads);
+  if (cycles.empty())
+    return 0;
+  const std::size_t before = triangles.size();
+  detail::LocalMesh mesh(triangles, num_vertices);
+  detail::LeastPerimeterScratch scratch;
+  std::vector<int> depth;
+  std::size_t cut = 0;
+  for (const Cycle& cycle : cycles) {
+    if (std::any_of(cycle.vertices.begin(), cycle.vertices.end(), [&](int v) {
+          return touched[v] != 0;
+        }))
+      continue;
+    if (waySidesMeet(mesh, cycle.vertices, MAX_HANDLE_DEPTH, depth) < 0)
+      continue;
+    const std::vector<int> reversed(cycle.vertices.rbegin(), cycle.vertices.rend());
+    if (cutAlong(points, mesh, cycle.vertices, touched, scratch) ||
+        cutAlong(points, mesh, reversed, touched, scratch))
+      ++cut;
+  }
+  if (cut > 0)
+    mesh.commit(before, incidences);
+  return cut;
+}
+
+} // namespace
+
+std::size_t
+cutShortHandles(const std::vector<Eigen::Vector3d>& points,
+                std::vector<Triangle>& triangles,
+                EdgeIncidences& incidences,
+                std::size_t min_tunnel_samples,
+                int threads)
+{
+  if (triangles.empty() || min_tunnel_samples < 4)
+    return 0;
+  // Handles side by side (a patch of noise has several) are cut a round each: a
+  // cut's vertices wait for the next round, with the hashes of the mesh it left.
+  std::size_t cut = 0;
+  for (int round = 0; round < MAX_ROUNDS; ++round) {
+    const std::size_t more =
+        cutRound(points, triangles, incidences, min_tunnel_samples, threads);
+    if (more == 0)
+      break;
+    cut += more;
+  }
+  return cut;
+}
+
+} // namespace cocone
+} // namespace pcl
