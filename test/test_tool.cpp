@@ -186,6 +186,7 @@ TEST_F(Tool, ReportAgreesWithTheLibrary)
                           "\"true_borders\"",
                           "\"holes_filled\"",
                           "\"filled_hole_sizes\"",
+                          "\"handles_cut\"",
                           "\"timings_ms\"",
                           "\"load\"",
                           "\"delaunay\"",

@@ -92,6 +92,7 @@ def test_filled_holes():
     kept = pcl_cocone.reconstruct(points)
     assert len(kept.border_loops) == 1 and kept.filled_holes == []
     assert kept.report["counts"]["true_borders"] == 1
+    assert kept.report["counts"]["handles_cut"] == 0  # a sphere has no handle
     result = pcl_cocone.reconstruct(points, hole_width=4.0)
     check_mesh(result, len(points))
     assert result.border_loops == []
