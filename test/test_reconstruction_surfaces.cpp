@@ -1729,3 +1729,24 @@ TEST(Reconstruction, HolesInRollingGroundStayOpen)
   EXPECT_EQ(topology.euler, 1 - 6);
   EXPECT_EQ(topology.components, 1u);
 }
+
+TEST(HandleCutting, ThinPlateOfRandomSamplesComesOutWithoutHandles)
+{
+  // A plate thinner than the spacing, 20,000 random samples: where its two sheets
+  // come within the spacing the walk closes a tunnel between them, one cycle of 3
+  // to 5 edges round it, short both ways; the cut leaves it a closed genus-0 plate
+  // (Euler 0 before, one handle).
+  const auto s = cocone_test::thinPlate(cocone_test::options(20000, 0.0, 1.0, false));
+  const auto r = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const auto m = cocone_test::scoreMesh(s, r);
+  std::printf("[ measured ] thin plate, 20000 random samples, %zu handles cut: %s\n",
+              r.counts.handles_cut,
+              m.str().c_str());
+  EXPECT_TRUE(m.topology.manifold()) << m.str();
+  EXPECT_GE(r.counts.handles_cut, 1u);
+  EXPECT_EQ(m.loops, 0u);
+  EXPECT_EQ(m.topology.components, 1u);
+  EXPECT_EQ(m.topology.euler, 2);
+  EXPECT_LT(m.max_distance, 1.5); // spacings: the patches stay on the plate
+}
