@@ -1730,6 +1730,38 @@ TEST(Reconstruction, HolesInRollingGroundStayOpen)
   EXPECT_EQ(topology.components, 1u);
 }
 
+TEST(HandleCutting, AnyTriangleListIsSafe)
+{
+  // Random triangle lists on a few points (non-manifold edges and vertices, borders
+  // on no loop, repeated triangles) and random tori with triangles taken out: no
+  // crash, and what comes back is the list its incidences group.
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<pcl::cocone::Triangle> mesh;
+    if (trial % 2 == 0) {
+      std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+      std::uniform_int_distribution<int> vertex(0, 9);
+      for (int i = 0; i < 10; ++i)
+        points.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+      for (int t = 0; t < 24; ++t) {
+        const pcl::cocone::Triangle tri{vertex(random), vertex(random), vertex(random)};
+        if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2])
+          mesh.push_back(tri);
+      }
+    }
+    else {
+      gridTorus(3 + trial % 4, 4 + trial % 7, points, mesh);
+      std::uniform_int_distribution<std::size_t> pick(0, mesh.size() - 1);
+      for (int k = trial % 3; k > 0; --k)
+        mesh.erase(mesh.begin() + static_cast<std::ptrdiff_t>(pick(random)));
+    }
+    pcl::cocone::EdgeIncidences inc(mesh);
+    pcl::cocone::cutShortHandles(points, mesh, inc);
+    EXPECT_EQ(inc.edges, pcl::cocone::EdgeIncidences(mesh).edges) << trial;
+  }
+}
+
 TEST(HandleCutting, ThinPlateOfRandomSamplesComesOutWithoutHandles)
 {
   // A plate thinner than the spacing, 20,000 random samples: where its two sheets

@@ -102,6 +102,8 @@ cohomologyHashes(const EdgeIncidences& inc,
   for (std::size_t l = 0; l < loops.size(); ++l)
     for (std::size_t i = 0; i < loops[l].size(); ++i) {
       const auto e = inc.find(loops[l][i], loops[l][(i + 1) % loops[l].size()]);
+      if (e < 0 || inc.count(static_cast<std::size_t>(e)) != 1 || sides[e][1] >= 0)
+        return {}; // not the loops of a manifold
       sides[e][1] = static_cast<int>(num_triangles + l);
     }
   for (const auto& side : sides)
