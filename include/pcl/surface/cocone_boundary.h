@@ -304,6 +304,11 @@ public:
    * winds round it, and last the patch of least total edge length within the same
    * reach (a long narrow hole, such as a slit along the rim of a plate thinner than
    * the spacing). No new vertex; the mesh stays an oriented manifold.
+   * Then the tunnels no sample lies round are closed too (handles of topological
+   * noise, where the walk met two sheets within the noise or a couple of spacings
+   * apart): a handle with a non-separating cycle of fewer than 6 edges whose sides
+   * meet again within 32 triangles is cut along the cycle and both cuts closed
+   * (getReconstructionCounts().handles_cut).
    * A loop that is wider than setMaxHoleWidth() of its rim's triangles with no
    * sample in it is a true border and is left as it is. getBoundaryPointIndices() is
    * not changed by it (the paper's output); getBoundaryLoops() lists the loops left.

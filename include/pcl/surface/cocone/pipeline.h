@@ -45,8 +45,9 @@ struct Parameters {
   std::size_t fill_hole_edges = 6;
   /** Close the border loops that are undersampled holes (fillUndersampledHoles(),
    * then fillHolesFromMesh() with the original Co-cone's triangles, which also
-   * cover parts too coarse for the flatness test): the mesh is open only where the
-   * sampled surface ends. */
+   * cover parts too coarse for the flatness test), and cut the handles no sample
+   * lies round (cutShortHandles()): the mesh is open only where the sampled surface
+   * ends. */
   bool fill_undersampled_holes = true;
   /** The longest edge of a hole's patch, in local spacings. Measured: the holes
    * noise tears where registered views overlap (one or two points missing) need
