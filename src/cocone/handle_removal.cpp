@@ -400,8 +400,9 @@ waySidesMeet(const detail::LocalMesh& mesh,
 /** Cut \a mesh along \a cycle (directed): the triangles on its left, the fans of
  * its vertices between its edges, taken out; the cycle and the band's outer loop
  * closed by least-perimeter patches of their vertices. False, and the mesh
- * unchanged, where the band is no annulus between the cycle and a simple loop of
- * other vertices clear of the mesh's borders and of earlier cuts (\a touched), or a
+ * unchanged, where the band is no annulus between the cycle (clear of \a touched,
+ * which the caller checks) and a simple loop of other vertices clear of the mesh's
+ * borders and of earlier cuts (\a touched), or a
  * patch needs an edge the mesh has or a degenerate triangle. */
 bool
 cutAlong(const std::vector<Eigen::Vector3d>& points,
@@ -476,9 +477,6 @@ cutAlong(const std::vector<Eigen::Vector3d>& points,
     return false; // more than one outer loop
   for (const int v : outer)
     if (on_cycle(v) || touched[v])
-      return false;
-  for (const int v : cycle)
-    if (touched[v])
       return false;
   for (const int t : band)
     for (const int v : mesh.triangles()[t])
