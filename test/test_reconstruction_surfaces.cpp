@@ -974,6 +974,73 @@ TEST(HandleCutting, HandleShortBothWaysIsCutAndTubesAreKept)
   }
 }
 
+TEST(HoleFilling, LoopsJoinedWhereTheOtherMeshJoinsThemThroughFreeSamples)
+{
+  // A grid torus whose tube lost two rows of triangles: a tube with two open rims,
+  // the ring of samples between them in no triangle (a tunnel's wall the walk left
+  // out). The other mesh, the whole torus, joins the two loops through them: with
+  // join_loops the wall comes back and the genus with it; without, no patch of one
+  // loop is a disk, so none is taken. A hole that one patch closes alone is not
+  // taken with join_loops.
+  const int around = 8, along = 16;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<pcl::cocone::Triangle> torus;
+  gridTorus(around, along, points, torus);
+  std::vector<pcl::cocone::Triangle> tube;
+  for (std::size_t t = 0; t < torus.size(); ++t) {
+    const std::size_t row = t / (2 * around); // between rings row and row + 1
+    if (row != 4 && row != 5)
+      tube.push_back(torus[t]);
+  }
+  const std::vector<double> spacing(points.size(), 1.3);
+  const auto sorted = [](std::vector<pcl::cocone::Triangle> mesh) {
+    for (auto& t : mesh)
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    std::sort(mesh.begin(), mesh.end());
+    return mesh;
+  };
+  for (const bool join : {false, true}) {
+    SCOPED_TRACE(join ? "joining loops" : "one loop at a time");
+    std::vector<pcl::cocone::Triangle> mesh = tube;
+    pcl::cocone::EdgeIncidences incidences(mesh);
+    auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+    ASSERT_EQ(loops.size(), 2u);
+    const auto filled = pcl::cocone::fillHolesFromMesh(
+        points, spacing, torus, mesh, incidences, loops, 2.75, 1000, 3, {}, join);
+    if (!join) {
+      EXPECT_EQ(filled.holes, 0u);
+      EXPECT_EQ(mesh, tube);
+      continue;
+    }
+    EXPECT_EQ(filled.holes, 2u);
+    EXPECT_TRUE(loops.empty());
+    EXPECT_EQ(sorted(mesh), sorted(torus));
+    const auto topology = pcl::cocone::analyzeMesh(mesh, points.size());
+    EXPECT_TRUE(topology.manifold());
+    EXPECT_EQ(topology.euler, 0); // genus 1 again
+    EXPECT_EQ(topology.components, 1u);
+    EXPECT_EQ(topology.vertices, points.size());
+    EXPECT_EQ(incidences.edges, pcl::cocone::EdgeIncidences(mesh).edges);
+  }
+  // One hole, closed by a patch of its own: left to the other passes.
+  std::vector<pcl::cocone::Triangle> mesh = torus;
+  mesh.erase(mesh.begin() + 4 * around, mesh.begin() + 4 * around + 2);
+  const auto holed = mesh;
+  pcl::cocone::EdgeIncidences incidences(mesh);
+  auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+  EXPECT_EQ(
+      pcl::cocone::fillHolesFromMesh(
+          points, spacing, torus, mesh, incidences, loops, 2.75, 1000, 3, {}, true)
+          .holes,
+      0u);
+  EXPECT_EQ(mesh, holed);
+  EXPECT_EQ(
+      pcl::cocone::fillHolesFromMesh(
+          points, spacing, torus, mesh, incidences, loops, 2.75, 1000, 3, {}, false)
+          .holes,
+      1u);
+}
+
 TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
 {
   // A square grid of unit spacing cut along one diagonal, with a round hole, and

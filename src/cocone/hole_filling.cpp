@@ -15,6 +15,7 @@
 
 #include <Eigen/Dense>
 
+#include "disjoint_sets.h"
 #include "least_perimeter.h"
 #include "local_mesh.h"
 #include "loop_plane.h"
@@ -375,6 +376,60 @@ eulerCharacteristic(const std::vector<Triangle>& triangles)
   return eulerCharacteristic(triangles, all);
 }
 
+/** The cycles of directed edges that leave each vertex once, each as its vertices
+ * in order; \a closed false if one ends open (it is cut short there). */
+std::vector<std::vector<int>>
+directedCycles(std::vector<DirectedEdge> edges, bool* closed = nullptr)
+{
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::vector<int>> cycles;
+  std::vector<std::uint8_t> walked(edges.size(), 0);
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    if (walked[i])
+      continue;
+    cycles.emplace_back();
+    for (std::size_t j = i; !walked[j];) {
+      walked[j] = 1;
+      cycles.back().push_back(edges[j][0]);
+      const auto next =
+          std::lower_bound(edges.begin(),
+                           edges.end(),
+                           DirectedEdge{edges[j][1], std::numeric_limits<int>::min()});
+      if (next == edges.end() || (*next)[0] != edges[j][1]) {
+        if (closed)
+          *closed = false;
+        break;
+      }
+      j = static_cast<std::size_t>(next - edges.begin());
+    }
+  }
+  return cycles;
+}
+
+/** Whether the triangles make one piece (through shared vertices). */
+bool
+connected(const std::vector<Triangle>& triangles)
+{
+  std::vector<int> vertices;
+  for (const Triangle& t : triangles)
+    vertices.insert(vertices.end(), t.begin(), t.end());
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const auto id = [&](int v) {
+    return static_cast<int>(std::lower_bound(vertices.begin(), vertices.end(), v) -
+                            vertices.begin());
+  };
+  detail::DisjointSets sets(vertices.size());
+  for (const Triangle& t : triangles) {
+    sets.unite(id(t[0]), id(t[1]));
+    sets.unite(id(t[0]), id(t[2]));
+  }
+  for (std::size_t v = 1; v < vertices.size(); ++v)
+    if (sets.find(static_cast<int>(v)) != sets.find(0))
+      return false;
+  return true;
+}
+
 } // namespace
 
 HoleFilling
@@ -387,7 +442,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   double reach,
                   std::size_t max_edges,
                   std::size_t band_per_edge,
-                  const std::vector<std::uint8_t>& true_border)
+                  const std::vector<std::uint8_t>& true_border,
+                  bool join_loops)
 {
   HoleFilling out;
   const std::size_t num_vertices = points.size();
@@ -493,25 +549,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
           }
         }
         // Each loop taken into the band is a cycle of its border edges.
-        std::sort(band_border.begin(), band_border.end());
-        absorbed.clear();
-        std::vector<std::uint8_t> seen(band_border.size(), 0);
-        for (std::size_t i = 0; i < band_border.size(); ++i) {
-          if (seen[i])
-            continue;
-          absorbed.emplace_back();
-          for (std::size_t j = i; !seen[j];) {
-            seen[j] = 1;
-            absorbed.back().push_back(band_border[j][0]);
-            const auto next = std::lower_bound(
-                band_border.begin(),
-                band_border.end(),
-                DirectedEdge{band_border[j][1], std::numeric_limits<int>::min()});
-            if (next == band_border.end() || (*next)[0] != band_border[j][1])
-              break;
-            j = static_cast<std::size_t>(next - band_border.begin());
-          }
-        }
+        absorbed = directedCycles(band_border);
       }
       // The rim: cycles that leave each vertex once (else the rim pinches there).
       std::sort(rim.begin(), rim.end());
@@ -702,26 +740,7 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
           ok = cut[i][0] != cut[i - 1][0];
         if (!ok)
           break;
-        std::vector<std::vector<int>> cut_loops;
-        std::vector<std::uint8_t> walked(cut.size(), 0);
-        for (std::size_t i = 0; i < cut.size() && ok; ++i) {
-          if (walked[i])
-            continue;
-          cut_loops.emplace_back();
-          for (std::size_t j = i; !walked[j];) {
-            walked[j] = 1;
-            cut_loops.back().push_back(cut[j][0]);
-            const auto next = std::lower_bound(
-                cut.begin(),
-                cut.end(),
-                DirectedEdge{cut[j][1], std::numeric_limits<int>::min()});
-            if (next == cut.end() || (*next)[0] != cut[j][1]) {
-              ok = false;
-              break;
-            }
-            j = static_cast<std::size_t>(next - cut.begin());
-          }
-        }
+        std::vector<std::vector<int>> cut_loops = directedCycles(cut, &ok);
         if (!ok)
           break;
         const std::size_t own = piece.size();
@@ -756,9 +775,20 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
         ok = (j - i == 1) == on_rim(patch_edges[i][0], patch_edges[i][1]);
         i = j;
       }
+      // A patch may instead join r disks of the band and holes (r rim cycles) into
+      // a sphere with r holes: a tunnel whose wall the walk left out, its rims open.
+      const long replaced = eulerCharacteristic(mesh.triangles(), band) +
+                            static_cast<long>(absorbed.size());
+      const long patch_euler = eulerCharacteristic(piece);
+      bool joins = false;
+      if (ok && join_loops && patch_euler != replaced) {
+        const long cycles = static_cast<long>(directedCycles(rim).size());
+        joins = cycles > 1 && replaced == cycles && patch_euler == 2 - cycles &&
+                connected(piece);
+      }
       ok = ok && border == rim.size() &&
-           eulerCharacteristic(piece) == eulerCharacteristic(mesh.triangles(), band) +
-                                             static_cast<long>(absorbed.size());
+           (join_loops ? joins || (patch_euler == replaced && absorbed.size() > 1)
+                       : patch_euler == replaced);
       if (!ok)
         break;
       for (const int t : band)
@@ -782,6 +812,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
     mesh.commit(before, incidences);
     loops = boundaryLoops(incidences, num_vertices);
   }
+  if (join_loops)
+    return out;
   const std::vector<std::uint8_t> used = usedVertices(triangles, num_vertices);
   const std::size_t after_patches = triangles.size();
 

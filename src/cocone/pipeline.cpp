@@ -296,7 +296,6 @@ reconstruct(Triangulation& dt,
                                    weight,
                                    rim_reach));
     };
-    patch_loops(HoleWeight::DIHEDRAL_ANGLES, 0.0);
     // What the Delaunay patches leave (loops, points in no triangle) the original
     // Co-cone's triangles may close (fillHolesFromMesh()): a part sampled too
     // coarsely for the flatness test. What those leave, the advancing front's may:
@@ -307,13 +306,13 @@ reconstruct(Triangulation& dt,
     // than FAR_NEIGHBOUR spacings): at a tile's cut those reached over most of the
     // tile (75,000 of 128,000 points for a 1M saddle's tile of 125,000, the
     // advancing front then taking 44 % of its time).
-    const auto open_region = [&](int rings, bool free_points) {
+    const auto open_region = [&](int rings, bool free_points, bool with_loops = true) {
       std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
       for (const auto& t : result.triangles)
         for (const int v : t)
           region[v] = 0;
       for (const auto& loop : result.border_loops)
-        if (fillable(loop))
+        if (with_loops && fillable(loop))
           for (const int v : loop)
             region[v] = 1;
       if (std::find(region.begin(), region.end(), 1) == region.end())
@@ -333,7 +332,8 @@ reconstruct(Triangulation& dt,
       return region;
     };
     const auto fill_from = [&](const std::vector<Triangle>& other,
-                               std::size_t band_per_edge) {
+                               std::size_t band_per_edge,
+                               bool join_loops) {
       record(fillHolesFromMesh(dt.points,
                                spacing,
                                other,
@@ -343,14 +343,24 @@ reconstruct(Triangulation& dt,
                                parameters.hole_reach,
                                parameters.max_hole_edges,
                                band_per_edge,
-                               true_border));
+                               true_border,
+                               join_loops));
     };
-    std::vector<std::uint8_t> region = open_region(PLAIN_COCONE_RINGS, true);
+    // First, where samples no triangle uses lie between loops (a tunnel's wall the
+    // walk left out, its two rims open), the advancing front's surface through them
+    // closes the loops together, before the patches below cap each on its own.
+    std::vector<std::uint8_t> region = open_region(ADVANCING_FRONT_RINGS, true, false);
     if (!region.empty())
-      fill_from(plainCoconeMesh(dt.points, cells, region, threads), 0);
+      fill_from(
+          advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE, true);
+    patch_loops(HoleWeight::DIHEDRAL_ANGLES, 0.0);
+    region = open_region(PLAIN_COCONE_RINGS, true);
+    if (!region.empty())
+      fill_from(plainCoconeMesh(dt.points, cells, region, threads), 0, false);
     region = open_region(ADVANCING_FRONT_RINGS, false);
     if (!region.empty())
-      fill_from(advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE);
+      fill_from(
+          advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE, false);
     // What the walk left between sheets a couple of spacings apart, closed by the
     // patches or not, is no surface: the specks go, with their loops and holes.
     counts.repair.speck =

@@ -144,6 +144,13 @@ fillUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
  *            patches bounded by the loop itself
  * \param[in] true_border per vertex: on a true border, whose loop stays open and
  *            which no band reaches; empty: none
+ * \param[in] join_loops only the patches that close two loops or more at once,
+ *            and these may join them: a patch bounded by r cycles of the band's rim,
+ *            where the band with its holes capped is r disks, may be a sphere with r
+ *            holes (connected, Euler characteristic 2 - r), so the genus grows by
+ *            r - 1 (a tunnel whose wall the walk left out, sampled but in no
+ *            triangle, its two rims open: capped each on its own, the tunnel would
+ *            close); no component of \a other is added
  */
 HoleFilling
 fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
@@ -155,7 +162,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
                   double reach,
                   std::size_t max_edges,
                   std::size_t band_per_edge = 0,
-                  const std::vector<std::uint8_t>& true_border = {});
+                  const std::vector<std::uint8_t>& true_border = {},
+                  bool join_loops = false);
 
 /** \brief Close border loops round samples no triangle uses, through them: the
  * sampling goes on inside the hole, but neither the walk nor the other meshes
