@@ -1041,6 +1041,65 @@ TEST(HoleFilling, LoopsJoinedWhereTheOtherMeshJoinsThemThroughFreeSamples)
       1u);
 }
 
+TEST(HoleFilling, JoinedPatchesKeepAnOrientedManifold)
+{
+  // Grid tori with random rows and triangles taken out, the other mesh a torus with
+  // triangles of its own taken out: whatever is joined or closed, the mesh stays an
+  // oriented manifold whose incidences and loops are its own, every patch joining
+  // loops adds one handle per loop it joins beyond the first.
+  std::mt19937 random(11);
+  std::size_t meshes = 0, handles = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    SCOPED_TRACE(trial);
+    const int around = 4 + trial % 5, along = 8 + trial % 9;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<pcl::cocone::Triangle> torus, mesh, other;
+    gridTorus(around, along, points, torus);
+    std::uniform_int_distribution<int> row(0, along - 1);
+    std::vector<std::uint8_t> cut_row(static_cast<std::size_t>(along), 0);
+    for (int k = 1 + trial % 3; k > 0; --k)
+      cut_row[static_cast<std::size_t>(row(random))] = 1;
+    std::bernoulli_distribution drop(0.03);
+    for (std::size_t t = 0; t < torus.size(); ++t) {
+      if (!cut_row[t / (2 * static_cast<std::size_t>(around))] && !drop(random))
+        mesh.push_back(torus[t]);
+      if (!drop(random))
+        other.push_back(torus[t]);
+    }
+    const std::vector<double> spacing(points.size(), 1.3);
+    const auto before = pcl::cocone::analyzeMesh(mesh, points.size());
+    if (!before.manifold())
+      continue; // a vertex whose triangles left two fans
+    ++meshes;
+    for (const bool join : {true, false}) {
+      std::vector<pcl::cocone::Triangle> mesh_in = mesh;
+      pcl::cocone::EdgeIncidences incidences(mesh_in);
+      auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+      const std::size_t loops_before = loops.size();
+      const auto filled = pcl::cocone::fillHolesFromMesh(
+          points, spacing, other, mesh_in, incidences, loops, 2.75, 1000, 3, {}, join);
+      const auto after = pcl::cocone::analyzeMesh(mesh_in, points.size());
+      EXPECT_TRUE(after.manifold());
+      EXPECT_EQ(incidences.edges, pcl::cocone::EdgeIncidences(mesh_in).edges);
+      EXPECT_EQ(loops, pcl::cocone::boundaryLoops(mesh_in, points.size()));
+      EXPECT_EQ(loops.size() + filled.holes, loops_before);
+      // Each loop closed on its own adds one to the Euler characteristic; joined
+      // loops add fewer (a handle each beyond the first), never more.
+      EXPECT_LE(after.euler - before.euler, static_cast<long>(filled.holes));
+      if (!join)
+        EXPECT_EQ(after.euler - before.euler, static_cast<long>(filled.holes));
+      else
+        handles += static_cast<std::size_t>(static_cast<long>(filled.holes) -
+                                            (after.euler - before.euler)) /
+                   2;
+    }
+  }
+  std::printf("[ measured ] %zu manifold tori, %zu handles made by joined patches\n",
+              meshes,
+              handles);
+  EXPECT_GT(handles, 0u); // the cases exercise the joining
+}
+
 TEST(HoleFilling, PatchReplacesTheBandWhereTheMeshesDisagree)
 {
   // A square grid of unit spacing cut along one diagonal, with a round hole, and
