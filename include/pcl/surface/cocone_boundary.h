@@ -289,7 +289,10 @@ public:
    * (joined by co-cone triangles of the local spacing, at least 64 points, fewer
    * than half in a triangle: the flatness test flagged it nearly all over, such as a
    * tube a few samples round under noise) gets the original Co-cone's mesh instead.
-   * After the reconstruction every border loop of up to 1,000 edges is closed when
+   * Where samples in no triangle lie between two loops or more and CGAL's advancing
+   * front over them closes those loops at once, its triangles do, joining them if
+   * so (a tunnel whose wall the walk left out: the genus grows). After that every
+   * border loop of up to 1,000 edges is closed when
    * CGAL's minimum-weight hole triangulation over the loop's Delaunay faces (or,
    * up to 40 edges, over all triangles of its points) finds a patch whose new edges
    * are all at most 4 local spacings long: an undersampled hole has samples all

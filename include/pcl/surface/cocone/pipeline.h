@@ -43,11 +43,12 @@ struct Parameters {
   /** Close border loops of at most this many edges with Delaunay triangles: holes
    * below the sampling resolution (one or a few missing triangles); 0: none. */
   std::size_t fill_hole_edges = 6;
-  /** Close the border loops that are undersampled holes (fillUndersampledHoles(),
-   * then fillHolesFromMesh() with the original Co-cone's triangles, which also
-   * cover parts too coarse for the flatness test), and cut the handles no sample
-   * lies round (cutShortHandles()): the mesh is open only where the sampled surface
-   * ends. */
+  /** Close the border loops that are undersampled holes (first those the advancing
+   * front joins through samples in no triangle, a tunnel's wall: fillHolesFromMesh()
+   * with join_loops; then fillUndersampledHoles(), then fillHolesFromMesh() with the
+   * original Co-cone's triangles, which also cover parts too coarse for the flatness
+   * test), and cut the handles no sample lies round (cutShortHandles()): the mesh is
+   * open only where the sampled surface ends. */
   bool fill_undersampled_holes = true;
   /** The longest edge of a hole's patch, in local spacings. Measured: the holes
    * noise tears where registered views overlap (one or two points missing) need
