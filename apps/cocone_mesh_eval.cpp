@@ -20,7 +20,8 @@
  * Each cloud goes to this library with the default parameters (threads from
  * --threads, 1 if not given) and to CGAL::advancing_front_surface_reconstruction with
  * its defaults (not with --no-peer). Per method the table gives the mesh's vertices,
- * triangles, components, Euler characteristic, whether it is an oriented 2-manifold
+ * triangles, components, Euler characteristic, genus ((2 components - loops -
+ * Euler) / 2, "?" where not a manifold), whether it is an oriented 2-manifold
  * and closed, its border loops (all wrong: the truth has none) with the edge counts
  * of the 5 largest and the median, the outliers the library set aside, and the
  * seconds. The peer's loops are the cycles of its boundary edges. The last column
@@ -304,7 +305,7 @@ printRow(const std::string& cloud,
          const std::string& verdict)
 {
   if (!row.error.empty()) {
-    std::printf("| %s | %s | %s | %zu | error: %s | | | | | | | | | | %.2f | %s |\n",
+    std::printf("| %s | %s | %s | %zu | error: %s | | | | | | | | | | | %.2f | %s |\n",
                 cloud.c_str(),
                 truth.c_str(),
                 method,
@@ -317,9 +318,14 @@ printRow(const std::string& cloud,
   const MeshTopology& m = row.topology;
   std::string largest, median;
   loopSummary(row.loop_sizes, largest, median);
+  // The genus of a surface with boundary: 2 components - loops - Euler = 2 genus.
+  const long twice_genus = 2 * static_cast<long>(m.components) -
+                           static_cast<long>(row.loop_sizes.size()) - m.euler;
+  const std::string genus =
+      m.manifold() && twice_genus % 2 == 0 ? std::to_string(twice_genus / 2) : "?";
   std::printf(
-      "| %s | %s | %s | %zu | %zu | %zu | %zu | %ld | %s | %s | %zu | %s | %s | %s | "
-      "%.2f | %s |\n",
+      "| %s | %s | %s | %zu | %zu | %zu | %zu | %ld | %s | %s | %s | %zu | %s | %s | "
+      "%s | %.2f | %s |\n",
       cloud.c_str(),
       truth.c_str(),
       method,
@@ -328,6 +334,7 @@ printRow(const std::string& cloud,
       m.triangles,
       m.components,
       m.euler,
+      genus.c_str(),
       yesNo(m.manifold()).c_str(),
       yesNo(m.triangles > 0 && m.boundary_edges == 0).c_str(),
       row.loop_sizes.size(),
@@ -405,10 +412,10 @@ main(int argc, char** argv)
     return 1;
   }
   std::printf("| cloud | truth | method | points | mesh vertices | triangles | "
-              "components | Euler | manifold | closed | wrong loops | largest loops "
-              "(edges) | median loop | outliers | s | ours <= peer |\n");
-  std::printf("|---|---|---|---:|---:|---:|---:|---:|---|---|---:|---|---:|---:|---:|"
-              "---|\n");
+              "components | Euler | genus | manifold | closed | wrong loops | largest "
+              "loops (edges) | median loop | outliers | s | ours <= peer |\n");
+  std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---|---:|---:|"
+              "---:|---|\n");
   int status = 0;
   for (const std::string& arg : files) {
     std::string path;
