@@ -558,7 +558,7 @@ constexpr double ALIKE_KURTOSIS = 1.8;
  * flattens a shape's creases and thin parts, noisy or not; the scales are then told
  * apart as between ALIKE_KURTOSIS and NOISE_KURTOSIS. Measured: clouds with Gaussian
  * noise of 0.3 to 1 spacing (the closed meshes' vertex sets, the synthetic surfaces,
- * registered views of them) 2.9 to 3.6, where the shape has sharp features 5.9 to
+ * registered views of them) 2.0 to 4.6, where the shape has sharp features 5.9 to
  * 44 (originalHead: the meshes keep the smoothed run); without noise the bunny's
  * vertex set 7.9, which the smoothing flattens in places (4 loops smoothed, 1 as
  * given); the Stanford range scans 18 to 186 (the given points mesh better) and 16
