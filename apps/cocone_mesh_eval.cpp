@@ -275,6 +275,16 @@ loopSummary(std::vector<std::size_t> s, std::string& largest, std::string& media
   median = buffer;
 }
 
+/** The genus of a surface with \a loops borders: 2 components - loops - Euler is
+ * twice it; "?" where that is odd. */
+std::string
+genusText(std::size_t components, std::size_t loops, long euler)
+{
+  const long twice =
+      2 * static_cast<long>(components) - static_cast<long>(loops) - euler;
+  return twice % 2 ? "?" : std::to_string(twice / 2);
+}
+
 std::string
 truthText(const Truth& t)
 {
@@ -283,10 +293,8 @@ truthText(const Truth& t)
   const MeshTopology& m = t.topology;
   std::string s = "Euler " + std::to_string(m.euler) + ", " +
                   std::to_string(m.components) + " comp.";
-  if (m.boundary_edges == 0) {
-    const long twice = 2 * static_cast<long>(m.components) - m.euler;
-    s += twice % 2 ? ", genus ?" : ", genus " + std::to_string(twice / 2);
-  }
+  if (m.boundary_edges == 0)
+    s += ", genus " + genusText(m.components, 0, m.euler);
   else
     s += ", " + std::to_string(m.boundary_edges) + " boundary edges (not closed)";
   if (!m.manifold())
@@ -318,11 +326,8 @@ printRow(const std::string& cloud,
   const MeshTopology& m = row.topology;
   std::string largest, median;
   loopSummary(row.loop_sizes, largest, median);
-  // The genus of a surface with boundary: 2 components - loops - Euler = 2 genus.
-  const long twice_genus = 2 * static_cast<long>(m.components) -
-                           static_cast<long>(row.loop_sizes.size()) - m.euler;
   const std::string genus =
-      m.manifold() && twice_genus % 2 == 0 ? std::to_string(twice_genus / 2) : "?";
+      m.manifold() ? genusText(m.components, row.loop_sizes.size(), m.euler) : "?";
   std::printf(
       "| %s | %s | %s | %zu | %zu | %zu | %zu | %ld | %s | %s | %s | %zu | %s | %s | "
       "%s | %.2f | %s |\n",

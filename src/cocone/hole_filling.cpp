@@ -15,7 +15,6 @@
 
 #include <Eigen/Dense>
 
-#include "disjoint_sets.h"
 #include "least_perimeter.h"
 #include "local_mesh.h"
 #include "loop_plane.h"
@@ -406,30 +405,6 @@ directedCycles(std::vector<DirectedEdge> edges, bool* closed = nullptr)
   return cycles;
 }
 
-/** Whether the triangles make one piece (through shared vertices). */
-bool
-connected(const std::vector<Triangle>& triangles)
-{
-  std::vector<int> vertices;
-  for (const Triangle& t : triangles)
-    vertices.insert(vertices.end(), t.begin(), t.end());
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  const auto id = [&](int v) {
-    return static_cast<int>(std::lower_bound(vertices.begin(), vertices.end(), v) -
-                            vertices.begin());
-  };
-  detail::DisjointSets sets(vertices.size());
-  for (const Triangle& t : triangles) {
-    sets.unite(id(t[0]), id(t[1]));
-    sets.unite(id(t[0]), id(t[2]));
-  }
-  for (std::size_t v = 1; v < vertices.size(); ++v)
-    if (sets.find(static_cast<int>(v)) != sets.find(0))
-      return false;
-  return true;
-}
-
 } // namespace
 
 HoleFilling
@@ -783,8 +758,10 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
       bool joins = false;
       if (ok && join_loops && patch_euler != replaced) {
         const long cycles = static_cast<long>(directedCycles(rim).size());
-        joins = cycles > 1 && replaced == cycles && patch_euler == 2 - cycles &&
-                connected(piece);
+        std::size_t pieces = 0;
+        if (cycles > 1 && replaced == cycles && patch_euler == 2 - cycles)
+          triangleComponents(piece, &pieces);
+        joins = pieces == 1;
       }
       ok = ok && border == rim.size() &&
            (join_loops ? joins || (patch_euler == replaced && absorbed.size() > 1)
