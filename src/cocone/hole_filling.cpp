@@ -15,6 +15,7 @@
 
 #include <Eigen/Dense>
 
+#include "disjoint_sets.h"
 #include "least_perimeter.h"
 #include "local_mesh.h"
 #include "loop_plane.h"
@@ -33,6 +34,36 @@ namespace pcl {
 namespace cocone {
 
 namespace {
+
+/** Whether each vertex of \a piece has one fan: its triangles there connected
+ * through the edges at it (a part of a manifold mesh can pinch at a vertex). */
+bool
+singleFans(const std::vector<Triangle>& piece)
+{
+  std::vector<std::pair<int, int>> corners; // (vertex, triangle)
+  for (std::size_t t = 0; t < piece.size(); ++t)
+    for (const int v : piece[t])
+      corners.emplace_back(v, static_cast<int>(t));
+  std::sort(corners.begin(), corners.end());
+  detail::DisjointSets fans;
+  for (std::size_t i = 0, j = 0; i < corners.size(); i = j) {
+    while (j < corners.size() && corners[j].first == corners[i].first)
+      ++j;
+    // Two triangles at v are in one fan if they share another vertex.
+    fans.reset(j - i);
+    for (std::size_t a = i; a < j; ++a)
+      for (std::size_t b = a + 1; b < j; ++b) {
+        const Triangle &s = piece[corners[a].second], &t = piece[corners[b].second];
+        for (const int u : s)
+          if (u != corners[i].first && std::find(t.begin(), t.end(), u) != t.end())
+            fans.unite(static_cast<int>(a - i), static_cast<int>(b - i));
+      }
+    for (std::size_t a = i; a < j; ++a)
+      if (fans.find(static_cast<int>(a - i)) != fans.find(0))
+        return false;
+  }
+  return true;
+}
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 
@@ -830,6 +861,9 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
     piece.clear();
     for (const int t : patch)
       piece.push_back(other[t]);
+    if (!singleFans(piece))
+      continue; // pinched at a vertex: no surface of its own
+
     if (border > 0) {
       EdgeIncidences piece_incidences(piece);
       std::vector<std::vector<int>> piece_loops =

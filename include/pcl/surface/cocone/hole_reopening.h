@@ -1,0 +1,58 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#pragma once
+
+#include <pcl/surface/cocone/complex.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace pcl {
+namespace cocone {
+
+/** \brief The triangles a hole is reopened by: those within \a rings rings of the
+ * loop \a loop (the first ring: the triangles with a corner on it; each next one:
+ * those with a corner on the ring before).
+ *
+ * Where two sheets meet within the noise, the walk leaves a crumpled cluster round a
+ * loop: fans folding over, the loop's arc and a chord bounding a handle. No patch of
+ * the loop's own vertices closes it without keeping the handle; taken out with the
+ * triangles round it, it leaves a wider hole whose patches (through the samples it
+ * frees) can close both.
+ * \param[in] triangles the mesh
+ * \param[in] loop a border loop of the mesh (vertex ids)
+ * \param[in] rings rings of triangles, at least 1
+ * \param[in] num_vertices the number of vertices
+ * \return per triangle: 1 if it is within the rings
+ */
+std::vector<std::uint8_t>
+trianglesRoundLoop(const std::vector<Triangle>& triangles,
+                   const std::vector<int>& loop,
+                   int rings,
+                   std::size_t num_vertices);
+
+/** \brief How far the vertices \a before uses and \a after does not lie from the
+ * surface that replaced them: the largest distance, in local spacings, from such a
+ * vertex to the nearest triangle of \a after with a corner in \a region. 0 if
+ * \a after uses every vertex \a before does; infinite if it has no triangle there.
+ * \param[in] points vertex positions
+ * \param[in] spacing per vertex its local spacing
+ * \param[in] before the mesh before
+ * \param[in] after the mesh after
+ * \param[in] region per vertex: round the change
+ */
+double
+farthestLeftOut(const std::vector<Eigen::Vector3d>& points,
+                const std::vector<double>& spacing,
+                const std::vector<Triangle>& before,
+                const std::vector<Triangle>& after,
+                const std::vector<std::uint8_t>& region);
+
+} // namespace cocone
+} // namespace pcl
