@@ -376,13 +376,13 @@ reconstruct(Triangulation& dt,
         return 2 * static_cast<long>(mesh.components) - static_cast<long>(loops) -
                mesh.euler;
       };
-      // One advancing front for every attempt, over the samples in no triangle and
-      // the loops' surroundings as far as they are reopened: remade for each, it
-      // took 90 % of the time (twenty loops on a noisy FinalBaseMesh: 16 s).
       const auto open_loops = static_cast<std::size_t>(std::count_if(
           result.border_loops.begin(), result.border_loops.end(), fillable));
       if (open_loops == 0 || open_loops > REOPENED_LOOPS)
         return false;
+      // One advancing front for every attempt, over the samples in no triangle and
+      // the loops' surroundings as far as they are reopened: remade for each, it
+      // took 90 % of the time (twenty loops on a noisy FinalBaseMesh: 16 s).
       const std::vector<std::uint8_t> front_region =
           open_region(ADVANCING_FRONT_RINGS + REOPENED_RINGS, true);
       if (front_region.empty())

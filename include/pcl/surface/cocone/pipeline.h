@@ -47,8 +47,9 @@ struct Parameters {
    * front joins through samples in no triangle, a tunnel's wall: fillHolesFromMesh()
    * with join_loops; then fillUndersampledHoles(), then fillHolesFromMesh() with the
    * original Co-cone's triangles, which also cover parts too coarse for the flatness
-   * test), and cut the handles no sample lies round (cutShortHandles()): the mesh is
-   * open only where the sampled surface ends. */
+   * test), cut the handles no sample lies round (cutShortHandles()), and reopen
+   * the loops left in crumpled clusters wider and close them again
+   * (trianglesRoundLoop()): the mesh is open only where the sampled surface ends. */
   bool fill_undersampled_holes = true;
   /** The longest edge of a hole's patch, in local spacings. Measured: the holes
    * noise tears where registered views overlap (one or two points missing) need
