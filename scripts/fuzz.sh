@@ -20,6 +20,16 @@ for target in pipeline readers; do
   echo "== fuzz_$target: fuzzing for $seconds s"
   (cd "$work" && "$OLDPWD/$build/fuzz_$target" "$target" -max_total_time="$seconds" \
      -rss_limit_mb=2048 -print_final_stats=1 > "fuzz_$target.log" 2>&1) ||
-    { tail -40 "$work/fuzz_$target.log"; ls "$work"; exit 1; }
+    { tail -40 "$work/fuzz_$target.log"
+      # The report's head (the stack) and the unit itself, kept beside the build:
+      # a crash found in a short run may not come back.
+      grep -A60 -m1 "ERROR: " "$work/fuzz_$target.log" || true
+      mkdir -p "$build/crashes"
+      cp "$work"/crash-* "$work"/leak-* "$work"/timeout-* "$work"/oom-* "$build/crashes/" \
+        2>/dev/null || true
+      for unit in "$build"/crashes/*; do
+        [ -f "$unit" ] && echo "kept $unit: $(od -An -tx1 -v "$unit" | tr -d ' \n' | head -c 9000)"
+      done
+      ls "$work"; exit 1; }
   grep -E "stat::number_of_executed_units|stat::new_units_added" "$work/fuzz_$target.log"
 done
