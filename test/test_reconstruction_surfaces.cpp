@@ -1063,11 +1063,12 @@ TEST(HoleReopening, RingsRoundALoopGrowToTheWholeMesh)
     ASSERT_EQ(within.size(), mesh.size());
     for (std::size_t t = 0; t < mesh.size(); ++t) {
       EXPECT_LE(previous[t], within[t]); // each ring holds the one before
-      if (rings == 1)
+      if (rings == 1) {
         EXPECT_EQ(within[t] != 0,
                   on_loop.count(mesh[t][0]) + on_loop.count(mesh[t][1]) +
                           on_loop.count(mesh[t][2]) >
                       0);
+      }
     }
     previous = within;
   }

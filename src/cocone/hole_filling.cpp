@@ -36,7 +36,8 @@ namespace cocone {
 namespace {
 
 /** Whether each vertex of \a piece has one fan: its triangles there connected
- * through the edges at it (a part of a manifold mesh can pinch at a vertex). */
+ * through the edges at it (a part of a manifold mesh can pinch at a vertex).
+ * vertexFans() would do, but over arrays the size of the cloud for every piece. */
 bool
 singleFans(const std::vector<Triangle>& piece)
 {

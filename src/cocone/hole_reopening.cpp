@@ -19,7 +19,8 @@ std::vector<std::uint8_t>
 trianglesRoundLoop(const std::vector<Triangle>& triangles,
                    const std::vector<int>& loop,
                    int rings,
-                   std::size_t num_vertices)
+                   std::size_t num_vertices,
+                   std::vector<std::uint8_t>* corners)
 {
   std::vector<std::uint8_t> reached(num_vertices, 0), within(triangles.size(), 0);
   for (const int v : loop)
@@ -35,6 +36,9 @@ trianglesRoundLoop(const std::vector<Triangle>& triangles,
     }
     reached = std::move(next);
   }
+  // After the last ring: the loop and every corner of the triangles within.
+  if (corners != nullptr)
+    *corners = std::move(reached);
   return within;
 }
 

@@ -362,6 +362,28 @@ reconstruct(Triangulation& dt,
                                true_border,
                                join_loops));
     };
+    // Holes round samples in no triangle, closed through them (see below).
+    const auto fill_through_inner_samples = [&]() {
+      record(fillHolesWithInnerSamples(dt.points,
+                                       spacing,
+                                       cells.triangles,
+                                       result.triangles,
+                                       incidences,
+                                       result.border_loops,
+                                       parameters.hole_reach,
+                                       parameters.max_hole_edges,
+                                       true_border));
+    };
+    // What is left where the sampling is coarser across the rim than along it
+    // (fillUndersampledHoles()): a hole no wider than hole_width rim triangles,
+    // patched with edges up to twice that; then long narrow holes, closed by the
+    // strip across them. Last, so that a hole with samples in it closes through
+    // them rather than over them.
+    const auto last_patches = [&]() {
+      patch_loops(HoleWeight::DIHEDRAL_ANGLES,
+                  RIM_REACH_PER_WIDTH * parameters.hole_width);
+      patch_loops(HoleWeight::LEAST_PERIMETER, 0.0);
+    };
     // A loop the passes leave open where two sheets meet within the noise runs
     // through a crumpled cluster (trianglesRoundLoop()). Reopened by one to
     // REOPENED_RINGS rings of triangles, the wider hole goes through the passes again
@@ -418,13 +440,9 @@ reconstruct(Triangulation& dt,
           if (!fillable(loops[l]) || !tried.insert(loops[l]).second)
             continue;
           for (int rings = 1; rings <= REOPENED_RINGS && !changed; ++rings) {
+            std::vector<std::uint8_t> region;
             const std::vector<std::uint8_t> drop =
-                trianglesRoundLoop(result.triangles, loops[l], rings, n);
-            std::vector<std::uint8_t> region(n, 0);
-            for (std::size_t t = 0; t < drop.size(); ++t)
-              if (drop[t])
-                for (const int v : result.triangles[t])
-                  region[v] = 1;
+                trianglesRoundLoop(result.triangles, loops[l], rings, n, &region);
             // A true border's loop is never changed (see fillable), nor reopened
             // into another.
             bool reaches_border = false;
@@ -455,18 +473,8 @@ reconstruct(Triangulation& dt,
               result.border_loops = reopened_loops();
               fill_from(front_near(region), BAND_PER_LOOP_EDGE, false);
               result.border_loops = reopened_loops();
-              record(fillHolesWithInnerSamples(dt.points,
-                                               spacing,
-                                               cells.triangles,
-                                               result.triangles,
-                                               incidences,
-                                               result.border_loops,
-                                               parameters.hole_reach,
-                                               parameters.max_hole_edges,
-                                               true_border));
-              patch_loops(HoleWeight::DIHEDRAL_ANGLES,
-                          RIM_REACH_PER_WIDTH * parameters.hole_width);
-              patch_loops(HoleWeight::LEAST_PERIMETER, 0.0);
+              fill_through_inner_samples();
+              last_patches();
               result.border_loops = boundaryLoops(incidences, n);
               const MeshTopology after = analyzeMesh(result.triangles, n);
               changed =
@@ -519,15 +527,7 @@ reconstruct(Triangulation& dt,
       result.filled_holes.erase(gone, result.filled_holes.end());
     }
     // Holes round samples no mesh made a surface of, closed through them.
-    record(fillHolesWithInnerSamples(dt.points,
-                                     spacing,
-                                     cells.triangles,
-                                     result.triangles,
-                                     incidences,
-                                     result.border_loops,
-                                     parameters.hole_reach,
-                                     parameters.max_hole_edges,
-                                     true_border));
+    fill_through_inner_samples();
     // Pieces whose holes no patch closes, closed whole by the advancing front.
     record(closePiecesWithAdvancingFront(dt.points,
                                          spacing,
@@ -539,14 +539,7 @@ reconstruct(Triangulation& dt,
                                          parameters.max_hole_edges,
                                          true_border,
                                          threads));
-    // What is left where the sampling is coarser across the rim than along it
-    // (fillUndersampledHoles()): a hole no wider than hole_width rim triangles,
-    // patched with edges up to twice that. Last, so that a hole with samples in it
-    // closes through them rather than over them.
-    patch_loops(HoleWeight::DIHEDRAL_ANGLES,
-                RIM_REACH_PER_WIDTH * parameters.hole_width);
-    // Long narrow holes left, closed by the strip across them.
-    patch_loops(HoleWeight::LEAST_PERIMETER, 0.0);
+    last_patches();
     // Tunnels too narrow for any sample round them: the walk's, between sheets
     // within the noise or a couple of spacings apart.
     counts.handles_cut = cutShortHandles(

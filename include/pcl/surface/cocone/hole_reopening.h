@@ -29,13 +29,16 @@ namespace cocone {
  * \param[in] loop a border loop of the mesh (vertex ids)
  * \param[in] rings rings of triangles, at least 1
  * \param[in] num_vertices the number of vertices
+ * \param[out] corners if given, per vertex: 1 if it is a corner of a triangle
+ *             within the rings (the loop's vertices among them)
  * \return per triangle: 1 if it is within the rings
  */
 std::vector<std::uint8_t>
 trianglesRoundLoop(const std::vector<Triangle>& triangles,
                    const std::vector<int>& loop,
                    int rings,
-                   std::size_t num_vertices);
+                   std::size_t num_vertices,
+                   std::vector<std::uint8_t>* corners = nullptr);
 
 /** \brief How far the vertices \a before uses and \a after does not lie from the
  * surface that replaced them: the largest distance, in local spacings, from such a
