@@ -5,7 +5,8 @@
  * cocone_mesh_eval: the topology of the reconstruction of closed reference shapes,
  * next to CGAL's advancing front, as a Markdown table.
  *
- *   cocone_mesh_eval [--threads T] [--no-peer] [--noise S [--seed N]] FILE[:EULER] ...
+ *   cocone_mesh_eval [--threads T] [--no-peer] [--noise S [--seed N]] [--write DIR]
+ *                    FILE[:EULER] ...
  *
  * e.g. cocone_mesh_eval ../shared/data/closed_meshes/bunny.obj
  *        ../shared/data/powercrust_samples/knot.pts:0
@@ -30,10 +31,14 @@
  * --noise S: a noisy scan of each shape, both methods on the same cloud: every
  * point moved by Gaussian noise of S local spacings (the mean distance to its 6
  * nearest other points) per coordinate, from seed N (default 1).
+ *
+ * --write DIR: each cloud as evaluated (with its noise) is written to DIR/NAME.pcd,
+ * so that pcl_cocone_reconstruction can be run on it (its report, its screenshot).
  */
 
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/conversions.h>
 
 #include "benchmark_advancing_front.h"
 #include "cloud_io.h"
@@ -387,6 +392,7 @@ main(int argc, char** argv)
   unsigned int threads = 1, seed = 1;
   bool peer = true;
   double noise = 0.0;
+  std::string write_dir;
   std::vector<std::string> files;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -398,6 +404,8 @@ main(int argc, char** argv)
       noise = std::strtod(argv[++a], nullptr);
     else if (arg == "--seed" && a + 1 < argc)
       seed = static_cast<unsigned int>(std::strtoul(argv[++a], nullptr, 10));
+    else if (arg == "--write" && a + 1 < argc)
+      write_dir = argv[++a];
     else if (arg.size() > 1 && arg[0] == '-') {
       std::fprintf(stderr, "unknown option '%s'\n", arg.c_str());
       return 1;
@@ -412,7 +420,8 @@ main(int argc, char** argv)
   if (files.empty()) {
     std::fprintf(
         stderr,
-        "usage: %s [--threads T] [--no-peer] [--noise S [--seed N]] FILE[:EULER] ...\n",
+        "usage: %s [--threads T] [--no-peer] [--noise S [--seed N]] [--write DIR] "
+        "FILE[:EULER] ...\n",
         argv[0]);
     return 1;
   }
@@ -458,6 +467,21 @@ main(int argc, char** argv)
     if (noise > 0.0)
       addNoise(points, noise, seed);
     const std::string name = baseName(path);
+    if (!write_dir.empty()) {
+      pcl::PointCloud<pcl::PointXYZ> cloud;
+      for (const Eigen::Vector3d& p : points)
+        cloud.push_back(pcl::PointXYZ(static_cast<float>(p.x()),
+                                      static_cast<float>(p.y()),
+                                      static_cast<float>(p.z())));
+      pcl::PCLPointCloud2 written;
+      pcl::toPCLPointCloud2(cloud, written);
+      const std::string out =
+          write_dir + "/" + name.substr(0, name.rfind('.')) + ".pcd";
+      if (!cocone_app::writeCloud(out, written, error)) {
+        std::fprintf(stderr, "%s\n", error.c_str());
+        status = 1;
+      }
+    }
     const std::string truth_text = truthText(truth);
     std::fprintf(stderr, "%s: %zu points\n", path.c_str(), points.size());
     const Row ours = runCocone(points, threads);
