@@ -1076,24 +1076,43 @@ TEST(HoleReopening, RingsRoundALoopGrowToTheWholeMesh)
             static_cast<std::ptrdiff_t>(mesh.size()));
 }
 
-TEST(HoleReopening, VerticesLeftOutAreMeasuredFromTheNewSurface)
+TEST(HoleReopening, VerticesLeftOutAreInsertedIntoTheNewSurface)
 {
   // A unit square of two triangles replaces the four round a centre vertex raised
-  // by 0.3: the centre is left out 0.3 from the new surface, in its spacing's units;
-  // nothing left out reads 0, and no new triangle round it, infinity.
+  // by 0.3 (0.6 of its spacing): within a reach of 1 spacing, the centre goes back
+  // into the triangle below it, split in three the same way round, and the mesh is
+  // an oriented disk again; with a reach of 0.5 spacings, or no new triangle round
+  // it, it stays out.
   const std::vector<Eigen::Vector3d> points = {
-      {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.4, 0.5, 0.3}};
+      {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.4, 0.6, 0.3}};
   const std::vector<pcl::cocone::Triangle> before = {
       {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
-  const std::vector<pcl::cocone::Triangle> after = {{0, 1, 2}, {0, 2, 3}};
+  const std::vector<pcl::cocone::Triangle> square = {{0, 1, 2}, {0, 2, 3}};
   const std::vector<double> spacing(points.size(), 0.5);
-  const std::vector<std::uint8_t> round = {1, 1, 1, 1, 1};
-  EXPECT_NEAR(
-      pcl::cocone::farthestLeftOut(points, spacing, before, after, round), 0.6, 1e-12);
-  EXPECT_EQ(pcl::cocone::farthestLeftOut(points, spacing, before, before, round), 0.0);
-  EXPECT_EQ(pcl::cocone::farthestLeftOut(
-                points, spacing, before, after, std::vector<std::uint8_t>(5, 0)),
-            std::numeric_limits<double>::infinity());
+  const std::vector<std::uint8_t> round(points.size(), 1);
+
+  std::vector<pcl::cocone::Triangle> after = square;
+  ASSERT_TRUE(pcl::cocone::insertLeftOut(points, spacing, before, after, round, 1.0));
+  ASSERT_EQ(after.size(), 4U);
+  EXPECT_EQ(after[0], square[0]); // the centre is above (0, 2, 3), not this one
+  EXPECT_EQ(after[1], (pcl::cocone::Triangle{0, 2, 4}));
+  EXPECT_EQ(after[2], (pcl::cocone::Triangle{2, 3, 4}));
+  EXPECT_EQ(after[3], (pcl::cocone::Triangle{3, 0, 4}));
+  const pcl::cocone::MeshTopology disk = pcl::cocone::analyzeMesh(after, points.size());
+  EXPECT_TRUE(disk.manifold());
+  EXPECT_EQ(disk.components, 1U);
+  EXPECT_EQ(disk.euler, 1);
+  EXPECT_EQ(disk.boundary_edges, 4U);
+
+  after = square;
+  EXPECT_FALSE(pcl::cocone::insertLeftOut(points, spacing, before, after, round, 0.5));
+  EXPECT_EQ(after, square);
+  EXPECT_FALSE(pcl::cocone::insertLeftOut(
+      points, spacing, before, after, std::vector<std::uint8_t>(5, 0), 1.0));
+  EXPECT_EQ(after, square);
+  after = before; // nothing left out
+  EXPECT_TRUE(pcl::cocone::insertLeftOut(points, spacing, before, after, round, 1.0));
+  EXPECT_EQ(after, before);
 }
 
 TEST(HoleFilling, JoinedPatchesKeepAnOrientedManifold)

@@ -42,40 +42,51 @@ trianglesRoundLoop(const std::vector<Triangle>& triangles,
   return within;
 }
 
-double
-farthestLeftOut(const std::vector<Eigen::Vector3d>& points,
-                const std::vector<double>& spacing,
-                const std::vector<Triangle>& before,
-                const std::vector<Triangle>& after,
-                const std::vector<std::uint8_t>& region)
+bool
+insertLeftOut(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<double>& spacing,
+              const std::vector<Triangle>& before,
+              std::vector<Triangle>& after,
+              const std::vector<std::uint8_t>& region,
+              double reach)
 {
-  // Exact distances are not needed (a length compared with a tolerance), so the
-  // plain double kernel.
+  // Exact distances are not needed (a length compared with a tolerance, the nearest
+  // of a few triangles), so the plain double kernel.
   using Kernel = CGAL::Simple_cartesian<double>;
   const auto point = [&](int v) {
     return Kernel::Point_3(points[v].x(), points[v].y(), points[v].z());
   };
   const std::vector<std::uint8_t> used_before = usedVertices(before, points.size()),
                                   used_after = usedVertices(after, points.size());
-  std::vector<int> left_out;
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (used_before[v] && !used_after[v])
-      left_out.push_back(static_cast<int>(v));
-  if (left_out.empty())
-    return 0.0;
-  std::vector<Kernel::Triangle_3> round;
-  for (const Triangle& t : after)
-    if (region[t[0]] || region[t[1]] || region[t[2]])
-      round.emplace_back(point(t[0]), point(t[1]), point(t[2]));
-  double farthest = 0.0;
-  for (const int v : left_out) {
+  bool all = true;
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    if (!used_before[v] || used_after[v])
+      continue;
+    const Kernel::Point_3 p = point(static_cast<int>(v));
     double nearest2 = std::numeric_limits<double>::infinity();
-    const Kernel::Point_3 p = point(v);
-    for (const auto& t : round)
-      nearest2 = std::min(nearest2, CGAL::squared_distance(p, t));
-    farthest = std::max(farthest, std::sqrt(nearest2) / spacing[v]);
+    std::size_t nearest = after.size();
+    for (std::size_t t = 0; t < after.size(); ++t) {
+      const Triangle& tri = after[t];
+      if (!region[tri[0]] && !region[tri[1]] && !region[tri[2]])
+        continue;
+      const double d2 = CGAL::squared_distance(
+          p, Kernel::Triangle_3(point(tri[0]), point(tri[1]), point(tri[2])));
+      if (d2 < nearest2) {
+        nearest2 = d2;
+        nearest = t;
+      }
+    }
+    if (nearest == after.size() || std::sqrt(nearest2) > reach * spacing[v]) {
+      all = false;
+      continue;
+    }
+    const Triangle t = after[nearest];
+    const int x = static_cast<int>(v);
+    after[nearest] = {t[0], t[1], x};
+    after.push_back({t[1], t[2], x});
+    after.push_back({t[2], t[0], x});
   }
-  return farthest;
+  return all;
 }
 
 } // namespace cocone

@@ -40,22 +40,29 @@ trianglesRoundLoop(const std::vector<Triangle>& triangles,
                    std::size_t num_vertices,
                    std::vector<std::uint8_t>* corners = nullptr);
 
-/** \brief How far the vertices \a before uses and \a after does not lie from the
- * surface that replaced them: the largest distance, in local spacings, from such a
- * vertex to the nearest triangle of \a after with a corner in \a region. 0 if
- * \a after uses every vertex \a before does; infinite if it has no triangle there.
+/** \brief The vertices \a before uses and \a after does not, inserted into the
+ * surface that replaced them: each into the nearest triangle of \a after with a
+ * corner in \a region, split in three round it (the orientation kept), if it lies
+ * within \a reach of its local spacings of that triangle.
+ *
+ * The split keeps an oriented manifold and its topology (the vertex was in no
+ * triangle), and the mesh goes through every sample it went through before.
  * \param[in] points vertex positions
  * \param[in] spacing per vertex its local spacing
  * \param[in] before the mesh before
- * \param[in] after the mesh after
+ * \param[in,out] after the mesh after, with the vertices inserted
  * \param[in] region per vertex: round the change
+ * \param[in] reach the farthest a vertex is inserted from, in its local spacings
+ * \return whether every vertex left out was inserted (if not, \a after holds those
+ *         that were)
  */
-double
-farthestLeftOut(const std::vector<Eigen::Vector3d>& points,
-                const std::vector<double>& spacing,
-                const std::vector<Triangle>& before,
-                const std::vector<Triangle>& after,
-                const std::vector<std::uint8_t>& region);
+bool
+insertLeftOut(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<double>& spacing,
+              const std::vector<Triangle>& before,
+              std::vector<Triangle>& after,
+              const std::vector<std::uint8_t>& region,
+              double reach);
 
 } // namespace cocone
 } // namespace pcl
