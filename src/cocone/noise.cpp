@@ -346,18 +346,15 @@ noiseLevel(const Jet& jet)
 }
 
 /** What the outlier test reads of a point's near neighbours (nearNeighbours()),
- * per vertex: how many there are, their mean spacing, p's distance to their plane,
- * and whether p stands beside them rather than off their plane. */
+ * per vertex: how many there are and their mean spacing. */
 struct Neighbourhoods {
-  explicit Neighbourhoods(std::size_t n)
-  : near(n, 0), beside(n, 0), spacing(n), offset(n)
-  {}
-  std::vector<std::uint8_t> near, beside;
-  std::vector<float> spacing, offset;
+  explicit Neighbourhoods(std::size_t n) : near(n, 0), spacing(n) {}
+  std::vector<std::uint8_t> near;
+  std::vector<float> spacing;
 };
 
 /** Fill in p's entry of \a hoods from its neighbour list; returns the number of
- * its near neighbours. */
+ * its near neighbours (0 if fewer than 3). */
 int
 describe(const std::vector<Eigen::Vector3d>& points,
          const std::array<int, NEAREST>& list,
@@ -368,26 +365,7 @@ describe(const std::vector<Eigen::Vector3d>& points,
   const int k = nearNeighbours(points, list, p, &mean);
   hoods.spacing[p] = static_cast<float>(mean);
   hoods.near[p] = static_cast<std::uint8_t>(k);
-  hoods.offset[p] = 0.0f;
-  hoods.beside[p] = 0;
-  if (k < 3)
-    return 0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < k; ++i) {
-    const Eigen::Vector3d q = points[list[i]] - points[p];
-    sum += q;
-    outer += q * q.transpose();
-  }
-  const Plane without = fitPlane(sum, outer, k);
-  const double normal_offset = std::abs(without.normal.dot(without.centroid));
-  hoods.offset[p] = static_cast<float>(normal_offset);
-  // Beside its neighbours rather than above them: p's foot on their plane is off
-  // their centroid by more than its height, or by more than 0.8 of their RMS spread.
-  const double foot =
-      (without.centroid - without.normal.dot(without.centroid) * without.normal).norm();
-  hoods.beside[p] = foot > normal_offset || foot > 0.8 * std::sqrt(without.spread);
-  return k;
+  return k < 3 ? 0 : k;
 }
 
 /** Whether p is an outlier: it stands off the jet of its neighbours without it by
@@ -412,7 +390,27 @@ isOutlier(const std::vector<Eigen::Vector3d>& points,
   std::nth_element(around.begin(), around.begin() + k / 2, around.begin() + k);
   const double around_spacing = around[k / 2];
   const bool isolated = hoods.spacing[p] > 3.0 * around_spacing;
-  if (!(hoods.offset[p] > 0.25 * around_spacing) || (hoods.beside[p] && !isolated))
+  // p is no farther from its neighbours' plane than from their centroid: a third
+  // of the points are answered without the plane (on a clean million: the noise
+  // analysis 0.93 -> 0.72 s). The margin keeps the answer the plane's own where the
+  // two distances tie.
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < k; ++i) {
+    const Eigen::Vector3d q = points[list[i]] - points[p];
+    sum += q;
+    outer += q * q.transpose();
+  }
+  if (!((sum / k).norm() > 0.25 * around_spacing * (1.0 - 1e-9)))
+    return false;
+  const Plane without = fitPlane(sum, outer, k);
+  const double offset = std::abs(without.normal.dot(without.centroid));
+  // Beside its neighbours rather than above them: p's foot on their plane is off
+  // their centroid by more than its height, or by more than 0.8 of their RMS spread.
+  const double foot =
+      (without.centroid - without.normal.dot(without.centroid) * without.normal).norm();
+  const bool beside = foot > offset || foot > 0.8 * std::sqrt(without.spread);
+  if (!(offset > 0.25 * around_spacing) || (beside && !isolated))
     return false;
   // A jet of 9 neighbours at least (a flying pixel has fewer near ones than a
   // surface point): a plane of a few misses a curved surface's point by as much as
