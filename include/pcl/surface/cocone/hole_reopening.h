@@ -18,7 +18,9 @@ namespace cocone {
 
 /** \brief The triangles a hole is reopened by: those within \a rings rings of the
  * loop \a loop (the first ring: the triangles with a corner on it; each next one:
- * those with a corner on the ring before).
+ * those with a corner on the ring before), and the whole star of any vertex that
+ * removing them would pinch (left with two fans or more), so that the triangles
+ * left are an oriented manifold where the mesh was one.
  *
  * Where two sheets meet within the noise, the walk leaves a crumpled cluster round a
  * loop: fans folding over, the loop's arc and a chord bounding a handle. No patch of
