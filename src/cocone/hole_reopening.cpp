@@ -89,6 +89,14 @@ insertLeftOut(const std::vector<Eigen::Vector3d>& points,
   };
   const std::vector<std::uint8_t> used_before = usedVertices(before, points.size()),
                                   used_after = usedVertices(after, points.size());
+  // The triangles round the change, found once: a split adds its two new ones.
+  const auto round_change = [&](const Triangle& tri) {
+    return region[tri[0]] || region[tri[1]] || region[tri[2]];
+  };
+  std::vector<std::size_t> round;
+  for (std::size_t t = 0; t < after.size(); ++t)
+    if (round_change(after[t]))
+      round.push_back(t);
   bool all = true;
   for (std::size_t v = 0; v < points.size(); ++v) {
     if (!used_before[v] || used_after[v])
@@ -96,9 +104,9 @@ insertLeftOut(const std::vector<Eigen::Vector3d>& points,
     const Kernel::Point_3 p = point(static_cast<int>(v));
     double nearest2 = std::numeric_limits<double>::infinity();
     std::size_t nearest = after.size();
-    for (std::size_t t = 0; t < after.size(); ++t) {
+    for (const std::size_t t : round) {
       const Triangle& tri = after[t];
-      if (!region[tri[0]] && !region[tri[1]] && !region[tri[2]])
+      if (!round_change(tri))
         continue;
       const double d2 = CGAL::squared_distance(
           p, Kernel::Triangle_3(point(tri[0]), point(tri[1]), point(tri[2])));
@@ -116,6 +124,8 @@ insertLeftOut(const std::vector<Eigen::Vector3d>& points,
     after[nearest] = {t[0], t[1], x};
     after.push_back({t[1], t[2], x});
     after.push_back({t[2], t[0], x});
+    round.push_back(after.size() - 2);
+    round.push_back(after.size() - 1);
   }
   return all;
 }
