@@ -458,40 +458,40 @@ reconstruct(Triangulation& dt,
             const EdgeIncidences kept_incidences = incidences;
             const ReconstructionCounts kept_counts = counts;
             const std::size_t kept_holes = result.filled_holes.size();
-            removeTriangles(result.triangles, drop);
-            if (analyzeMesh(result.triangles, n).manifold()) {
+            // What the rings leave is an oriented manifold (trianglesRoundLoop()
+            // takes the stars they would pinch), and its incidences those of the
+            // mesh less the triangles dropped: neither is made again over the whole
+            // mesh per attempt.
+            removeTriangles(result.triangles, drop, &incidences);
+            // Only the reopened hole goes through the passes again: the other
+            // loops went through them as they are (on the range scans, patching
+            // them all again for each attempt took a fifth of the time).
+            const auto reopened_loops = [&]() {
+              auto loops_now = boundaryLoops(incidences, n);
+              loops_now.erase(std::remove_if(loops_now.begin(),
+                                             loops_now.end(),
+                                             [&](const std::vector<int>& loop) {
+                                               return !region[loop[0]];
+                                             }),
+                              loops_now.end());
+              return loops_now;
+            };
+            result.border_loops = reopened_loops();
+            fill_from(front_near(region), BAND_PER_LOOP_EDGE, false);
+            result.border_loops = reopened_loops();
+            fill_through_inner_samples();
+            last_patches();
+            const std::size_t patched = result.triangles.size();
+            const bool inserted = insertLeftOut(
+                dt.points, spacing, kept, result.triangles, region, REOPENED_REACH);
+            if (result.triangles.size() != patched)
               incidences = EdgeIncidences(result.triangles);
-              // Only the reopened hole goes through the passes again: the other
-              // loops went through them as they are (on the range scans, patching
-              // them all again for each attempt took a fifth of the time).
-              const auto reopened_loops = [&]() {
-                auto loops_now = boundaryLoops(incidences, n);
-                loops_now.erase(std::remove_if(loops_now.begin(),
-                                               loops_now.end(),
-                                               [&](const std::vector<int>& loop) {
-                                                 return !region[loop[0]];
-                                               }),
-                                loops_now.end());
-                return loops_now;
-              };
-              result.border_loops = reopened_loops();
-              fill_from(front_near(region), BAND_PER_LOOP_EDGE, false);
-              result.border_loops = reopened_loops();
-              fill_through_inner_samples();
-              last_patches();
-              const std::size_t patched = result.triangles.size();
-              const bool inserted = insertLeftOut(
-                  dt.points, spacing, kept, result.triangles, region, REOPENED_REACH);
-              if (result.triangles.size() != patched)
-                incidences = EdgeIncidences(result.triangles);
-              result.border_loops = boundaryLoops(incidences, n);
-              const MeshTopology after = analyzeMesh(result.triangles, n);
-              changed =
-                  after.manifold() && after.components == before.components &&
-                  result.border_loops.size() < loops.size() &&
-                  twice_genus(after, result.border_loops.size()) <= genus_before &&
-                  inserted;
-            }
+            result.border_loops = boundaryLoops(incidences, n);
+            const MeshTopology after = analyzeMesh(result.triangles, n);
+            changed = after.manifold() && after.components == before.components &&
+                      result.border_loops.size() < loops.size() &&
+                      twice_genus(after, result.border_loops.size()) <= genus_before &&
+                      inserted;
             if (!changed) {
               result.triangles = kept;
               counts = kept_counts;
