@@ -454,8 +454,8 @@ reconstruct(Triangulation& dt,
               reaches_border = region[v] && true_border[v];
             if (reaches_border)
               break;
-            const std::vector<Triangle> kept = result.triangles;
-            const EdgeIncidences kept_incidences = incidences;
+            std::vector<Triangle> kept = result.triangles;
+            EdgeIncidences kept_incidences = incidences;
             const ReconstructionCounts kept_counts = counts;
             const std::size_t kept_holes = result.filled_holes.size();
             // What the rings leave is an oriented manifold (trianglesRoundLoop()
@@ -493,10 +493,10 @@ reconstruct(Triangulation& dt,
                       twice_genus(after, result.border_loops.size()) <= genus_before &&
                       inserted;
             if (!changed) {
-              result.triangles = kept;
+              result.triangles = std::move(kept);
               counts = kept_counts;
               result.filled_holes.resize(kept_holes);
-              incidences = kept_incidences;
+              incidences = std::move(kept_incidences);
               result.border_loops = loops;
             }
           }
