@@ -93,39 +93,59 @@ insertLeftOut(const std::vector<Eigen::Vector3d>& points,
   const auto round_change = [&](const Triangle& tri) {
     return region[tri[0]] || region[tri[1]] || region[tri[2]];
   };
-  std::vector<std::size_t> round;
+  // Each with a ball round it (its centroid, the farthest corner): a triangle whose
+  // ball is farther off than the nearest triangle so far is not measured.
+  struct Round {
+    std::size_t t;
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  const auto ball = [&](std::size_t t) {
+    const Triangle& tri = after[t];
+    Round r{t, (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0, 0.0};
+    for (const int v : tri)
+      r.radius = std::max(r.radius, (points[v] - r.centre).norm());
+    return r;
+  };
+  std::vector<Round> round;
   for (std::size_t t = 0; t < after.size(); ++t)
     if (round_change(after[t]))
-      round.push_back(t);
+      round.push_back(ball(t));
   bool all = true;
   for (std::size_t v = 0; v < points.size(); ++v) {
     if (!used_before[v] || used_after[v])
       continue;
     const Kernel::Point_3 p = point(static_cast<int>(v));
     double nearest2 = std::numeric_limits<double>::infinity();
-    std::size_t nearest = after.size();
-    for (const std::size_t t : round) {
-      const Triangle& tri = after[t];
+    std::size_t nearest = round.size();
+    for (std::size_t i = 0; i < round.size(); ++i) {
+      const Triangle& tri = after[round[i].t];
       if (!round_change(tri))
+        continue;
+      // The ball is no farther than the triangle (a margin for the rounding).
+      const double below = (points[v] - round[i].centre).norm() - round[i].radius;
+      if (below > 0.0 && below * below > nearest2 * (1.0 + 1e-9))
         continue;
       const double d2 = CGAL::squared_distance(
           p, Kernel::Triangle_3(point(tri[0]), point(tri[1]), point(tri[2])));
       if (d2 < nearest2) {
         nearest2 = d2;
-        nearest = t;
+        nearest = i;
       }
     }
-    if (nearest == after.size() || std::sqrt(nearest2) > reach * spacing[v]) {
+    if (nearest == round.size() || std::sqrt(nearest2) > reach * spacing[v]) {
       all = false;
       continue;
     }
-    const Triangle t = after[nearest];
+    const std::size_t split = round[nearest].t;
+    const Triangle t = after[split];
     const int x = static_cast<int>(v);
-    after[nearest] = {t[0], t[1], x};
+    after[split] = {t[0], t[1], x};
     after.push_back({t[1], t[2], x});
     after.push_back({t[2], t[0], x});
-    round.push_back(after.size() - 2);
-    round.push_back(after.size() - 1);
+    round[nearest] = ball(split);
+    round.push_back(ball(after.size() - 2));
+    round.push_back(ball(after.size() - 1));
   }
   return all;
 }

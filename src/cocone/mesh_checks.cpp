@@ -261,9 +261,16 @@ triangleComponents(const EdgeIncidences& inc,
 MeshTopology
 analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices)
 {
+  return analyzeMesh(oriented, num_vertices, EdgeIncidences(oriented));
+}
+
+MeshTopology
+analyzeMesh(const std::vector<Triangle>& oriented,
+            std::size_t num_vertices,
+            const EdgeIncidences& inc)
+{
   MeshTopology topo;
   topo.triangles = oriented.size();
-  const EdgeIncidences inc(oriented);
   topo.edges = inc.edges.size();
   std::size_t components = 0;
   const std::vector<int> comp = triangleComponents(inc, oriented.size(), &components);

@@ -438,7 +438,7 @@ reconstruct(Triangulation& dt,
       for (bool changed = true; changed; any = any || changed) {
         changed = false;
         const std::vector<std::vector<int>> loops = result.border_loops;
-        const MeshTopology before = analyzeMesh(result.triangles, n);
+        const MeshTopology before = analyzeMesh(result.triangles, n, incidences);
         const long genus_before = twice_genus(before, loops.size());
         for (std::size_t l = 0; l < loops.size() && !changed; ++l) {
           if (!fillable(loops[l]) || !tried.insert(loops[l]).second)
@@ -487,7 +487,7 @@ reconstruct(Triangulation& dt,
             if (result.triangles.size() != patched)
               incidences = EdgeIncidences(result.triangles);
             result.border_loops = boundaryLoops(incidences, n);
-            const MeshTopology after = analyzeMesh(result.triangles, n);
+            const MeshTopology after = analyzeMesh(result.triangles, n, incidences);
             changed = after.manifold() && after.components == before.components &&
                       result.border_loops.size() < loops.size() &&
                       twice_genus(after, result.border_loops.size()) <= genus_before &&

@@ -100,6 +100,13 @@ struct MeshTopology {
 MeshTopology
 analyzeMesh(const std::vector<Triangle>& oriented, std::size_t num_vertices);
 
+/** \brief Count the topology of an oriented triangle mesh whose edges \a inc
+ * groups already (EdgeIncidences of \a oriented). */
+MeshTopology
+analyzeMesh(const std::vector<Triangle>& oriented,
+            std::size_t num_vertices,
+            const EdgeIncidences& inc);
+
 /** \brief The borders of an oriented 2-manifold mesh as closed vertex loops, each
  * traversed with the mesh on its left, starting at its lowest vertex id; loops are
  * sorted by that vertex. */
