@@ -26,14 +26,23 @@ public:
   LocalMesh(std::vector<Triangle>& triangles, std::size_t num_vertices)
   : triangles_(triangles)
   , dead_(triangles.size(), 0)
-  , star_(num_vertices)
+  , first_(num_vertices + 1, 0)
+  , added_(num_vertices)
   , uses_(num_vertices, 0)
   {
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      for (const int v : triangles[t]) {
-        star_[v].push_back(static_cast<int>(t));
+    // The stars in compressed rows, the triangles added later in a list per vertex:
+    // a stage builds this over the whole mesh for a few holes (per attempt of the
+    // hole reopening), and a vector per vertex took most of that time.
+    for (const auto& t : triangles)
+      for (const int v : t)
         ++uses_[v];
-      }
+    for (std::size_t v = 0; v < num_vertices; ++v)
+      first_[v + 1] = first_[v] + static_cast<std::size_t>(uses_[v]);
+    star_.resize(first_[num_vertices]);
+    std::vector<std::size_t> next(first_.begin(), first_.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (const int v : triangles[t])
+        star_[next[v]++] = static_cast<int>(t);
   }
 
   const std::vector<Triangle>&
@@ -51,7 +60,10 @@ public:
   void
   forStar(int v, const Body& body) const
   {
-    for (const int t : star_[v])
+    for (std::size_t i = first_[v]; i < first_[v + 1]; ++i)
+      if (!dead_[star_[i]])
+        body(star_[i]);
+    for (const int t : added_[v])
       if (!dead_[t])
         body(t);
   }
@@ -95,7 +107,7 @@ public:
     triangles_.push_back(t);
     dead_.push_back(0);
     for (const int v : t) {
-      star_[v].push_back(id);
+      added_[v].push_back(id);
       ++uses_[v];
     }
   }
@@ -123,7 +135,9 @@ public:
 private:
   std::vector<Triangle>& triangles_;
   std::vector<std::uint8_t> dead_;
-  std::vector<std::vector<int>> star_;
+  std::vector<std::size_t> first_; ///< per vertex, its first entry in star_
+  std::vector<int> star_;
+  std::vector<std::vector<int>> added_;
   std::vector<int> uses_;
 };
 
