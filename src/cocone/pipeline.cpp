@@ -24,12 +24,14 @@
 #include <Eigen/Geometry>
 
 #include "caller_ids.h"
+#include "cocone_neighbours.h"
 #include "disjoint_sets.h"
 #include "edge_sort.h"
 #include "points.h"
 #include "stopwatch.h"
 
 #include <algorithm>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <new>
@@ -183,12 +185,11 @@ constexpr std::size_t BAND_PER_LOOP_EDGE = 3;
 /** Rings of triangles a loop left open is reopened by at most (see reopen_loops in
  * reconstruct()). */
 constexpr int REOPENED_RINGS = 3;
-/** Loops are reopened only where the mesh has at most this many left open (that
- * the patches could close): a mesh nearly closed, with a few crumpled clusters.
- * More mean a surface far from closed, which reopening does not repair, and each
- * attempt costs a pass over the mesh: the merged Stanford scans' run on the other
- * scale leaves 84, and trying them all took the run from 14 to 39 s. Measured:
- * the noisy closed meshes leave 2 to 20, the noisy thin plates up to 16. */
+/** Loops reopened at most (those the patches could close; where more are left
+ * open, the shortest): each attempt costs a pass over the mesh. Measured: the noisy
+ * closed meshes leave 2 to 20 with noise up to a spacing, FinalBaseMesh 48 with
+ * 1.5 (all tried: 22 loops left, 24 shortest: 28, none: 49); the merged Stanford
+ * scans' run on the other scale leaves 84 (all tried: +8 s, 24: +2.7 s). */
 constexpr std::size_t REOPENED_LOOPS = 24;
 /** A vertex a reopened and closed hole leaves out is inserted into the new surface
  * if it lies within this many local spacings of it (else the attempt is undone): a
@@ -326,17 +327,7 @@ reconstruct(Triangulation& dt,
     // than FAR_NEIGHBOUR spacings): at a tile's cut those reached over most of the
     // tile (75,000 of 128,000 points for a 1M saddle's tile of 125,000, the
     // advancing front then taking 44 % of its time).
-    const auto open_region = [&](int rings, bool free_points, bool with_loops = true) {
-      std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
-      for (const auto& t : result.triangles)
-        for (const int v : t)
-          region[v] = 0;
-      for (const auto& loop : result.border_loops)
-        if (with_loops && fillable(loop))
-          for (const int v : loop)
-            region[v] = 1;
-      if (std::find(region.begin(), region.end(), 1) == region.end())
-        return std::vector<std::uint8_t>();
+    const auto grow = [&](std::vector<std::uint8_t> region, int rings) {
       for (int ring = 0; ring < rings; ++ring) {
         std::vector<std::uint8_t> grown = region;
         for (const auto& t : cells.triangles)
@@ -350,6 +341,52 @@ reconstruct(Triangulation& dt,
         region = std::move(grown);
       }
       return region;
+    };
+    const auto open_region = [&](int rings, bool free_points, bool with_loops = true) {
+      std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
+      for (const auto& t : result.triangles)
+        for (const int v : t)
+          region[v] = 0;
+      for (const auto& loop : result.border_loops)
+        if (with_loops && fillable(loop))
+          for (const int v : loop)
+            region[v] = 1;
+      if (std::find(region.begin(), region.end(), 1) == region.end())
+        return std::vector<std::uint8_t>();
+      return grow(std::move(region), rings);
+    };
+    // The same round the given loops and those samples in no triangle that co-cone
+    // triangles join to them, within the rings or through one another (the samples
+    // in and round their holes), rather than every such sample of the cloud: on the
+    // merged Stanford scans, whose free samples are spread over the whole cloud,
+    // the advancing front for the one loop the hole filling leaves took 0.63 s over
+    // all of them, 0.13 s over those joined to it.
+    const auto loops_region = [&](const std::vector<std::vector<int>>& loops,
+                                  int rings) {
+      std::vector<std::uint8_t> start(dt.points.size(), 0);
+      for (const auto& loop : loops)
+        for (const int v : loop)
+          start[v] = 1;
+      const std::vector<std::uint8_t> near = grow(start, rings);
+      const std::vector<std::uint8_t> used =
+          usedVertices(result.triangles, dt.points.size());
+      const detail::CoconeNeighbours free_around = detail::coconeNeighbours(
+          cells.triangles, dt.points.size(), [&](int b) { return !used[b]; });
+      std::vector<int> queue;
+      for (std::size_t v = 0; v < near.size(); ++v)
+        if (near[v] && !used[v]) {
+          start[v] = 1;
+          queue.push_back(static_cast<int>(v));
+        }
+      for (std::size_t q = 0; q < queue.size(); ++q)
+        for (std::size_t a = free_around.first[queue[q]];
+             a < free_around.first[queue[q] + 1];
+             ++a)
+          if (!start[free_around.neighbour[a]]) {
+            start[free_around.neighbour[a]] = 1;
+            queue.push_back(free_around.neighbour[a]);
+          }
+      return grow(std::move(start), rings);
     };
     const auto fill_from = [&](const std::vector<Triangle>& other,
                                std::size_t band_per_edge,
@@ -402,17 +439,31 @@ reconstruct(Triangulation& dt,
         return 2 * static_cast<long>(mesh.components) - static_cast<long>(loops) -
                mesh.euler;
       };
-      const auto open_loops = static_cast<std::size_t>(std::count_if(
-          result.border_loops.begin(), result.border_loops.end(), fillable));
-      if (open_loops == 0 || open_loops > REOPENED_LOOPS)
+      // The loops tried: every one left open; where more are, the REOPENED_LOOPS
+      // shortest (a crumpled cluster's loop is short: on FinalBaseMesh with noise
+      // 1.5, 48 loops, none of more than 77 edges closed).
+      std::vector<std::vector<int>> chosen;
+      std::copy_if(result.border_loops.begin(),
+                   result.border_loops.end(),
+                   std::back_inserter(chosen),
+                   fillable);
+      if (chosen.empty())
         return false;
+      const bool all = chosen.size() <= REOPENED_LOOPS;
+      if (!all) {
+        std::stable_sort(chosen.begin(),
+                         chosen.end(),
+                         [](const std::vector<int>& a, const std::vector<int>& b) {
+                           return a.size() < b.size();
+                         });
+        chosen.resize(REOPENED_LOOPS);
+      }
+      const std::set<std::vector<int>> shortest(chosen.begin(), chosen.end());
       // One advancing front for every attempt, over the samples in no triangle and
       // the loops' surroundings as far as they are reopened: remade for each, it
       // took 90 % of the time (twenty loops on a noisy FinalBaseMesh: 16 s).
       const std::vector<std::uint8_t> front_region =
-          open_region(ADVANCING_FRONT_RINGS + REOPENED_RINGS, true);
-      if (front_region.empty())
-        return false;
+          loops_region(chosen, ADVANCING_FRONT_RINGS + REOPENED_RINGS);
       const std::vector<Triangle> front =
           advancingFrontMesh(dt.points, front_region, threads);
       // Its triangles within FRONT_RINGS of a reopened region: the patches' and
@@ -441,7 +492,8 @@ reconstruct(Triangulation& dt,
         const MeshTopology before = analyzeMesh(result.triangles, n, incidences);
         const long genus_before = twice_genus(before, loops.size());
         for (std::size_t l = 0; l < loops.size() && !changed; ++l) {
-          if (!fillable(loops[l]) || !tried.insert(loops[l]).second)
+          if (!fillable(loops[l]) || (!all && shortest.count(loops[l]) == 0) ||
+              !tried.insert(loops[l]).second)
             continue;
           for (int rings = 1; rings <= REOPENED_RINGS && !changed; ++rings) {
             std::vector<std::uint8_t> region;
@@ -481,17 +533,22 @@ reconstruct(Triangulation& dt,
             result.border_loops = reopened_loops();
             fill_through_inner_samples();
             last_patches();
-            const std::size_t patched = result.triangles.size();
-            const bool inserted = insertLeftOut(
-                dt.points, spacing, kept, result.triangles, region, REOPENED_REACH);
-            if (result.triangles.size() != patched)
-              incidences = EdgeIncidences(result.triangles);
+            // The loop must have closed: else the attempt is undone without the
+            // insertion and the checks (an inserted vertex changes no border).
             result.border_loops = boundaryLoops(incidences, n);
-            const MeshTopology after = analyzeMesh(result.triangles, n, incidences);
-            changed = after.manifold() && after.components == before.components &&
-                      result.border_loops.size() < loops.size() &&
-                      twice_genus(after, result.border_loops.size()) <= genus_before &&
-                      inserted;
+            if (result.border_loops.size() < loops.size()) {
+              const std::size_t patched = result.triangles.size();
+              const bool inserted = insertLeftOut(
+                  dt.points, spacing, kept, result.triangles, region, REOPENED_REACH);
+              if (result.triangles.size() != patched) {
+                incidences = EdgeIncidences(result.triangles);
+                result.border_loops = boundaryLoops(incidences, n);
+              }
+              const MeshTopology after = analyzeMesh(result.triangles, n, incidences);
+              changed = inserted && after.manifold() &&
+                        after.components == before.components &&
+                        twice_genus(after, result.border_loops.size()) <= genus_before;
+            }
             if (!changed) {
               result.triangles = std::move(kept);
               counts = kept_counts;
