@@ -198,6 +198,14 @@ constexpr std::size_t REOPENED_LOOPS = 24;
  * FinalBaseMesh 10, 10, 7 and 7 handles, the casting 17, 14, 14 and 14; 1 spacing
  * without the insertion (the vertices further out left out) 14 and 17. */
 constexpr double REOPENED_REACH = 2.0;
+/** ... or this many sigmas of the cloud's noise (Result::noise_level, read in
+ * spacings before any smoothing) where that is wider: the band two noisy sheets
+ * meet in grows with the noise. Measured on the closed meshes, knot, hot dogs and
+ * kitten with noise 0.3, 0.5 and 1.0, seeds 2 and 3: wrong loops 133 and handles
+ * 160 with the reach of 2 alone, 125 and 155 with 3 sigmas (a fixed reach of 4: 123
+ * and 152, but it also closes a dropout on two of the Stanford range scans, whose
+ * noise reads 0.15). */
+constexpr double REOPENED_SIGMAS = 3.0;
 
 /** The fewest vertices of a piece of the mesh (see dropSpecks()): the shards
  * between spheres two spacings apart have 4 to 7, the tetrahedra of outlier clusters
@@ -431,8 +439,9 @@ reconstruct(Triangulation& dt,
     // (the advancing front through the samples it frees, the inner-samples and the
     // Delaunay patches). The vertices it leaves out go into its nearest triangles
     // (insertLeftOut()), and the result is kept only if each was within
-    // REOPENED_REACH local spacings of them, and the loop closed without a handle or
-    // a piece more, the mesh an oriented manifold.
+    // REOPENED_REACH local spacings of them (REOPENED_SIGMAS of the noise where wider),
+    // and the loop closed without a handle or a piece more, the mesh an oriented
+    // manifold.
     const auto reopen_loops = [&]() {
       const std::size_t n = dt.points.size();
       const auto twice_genus = [&](const MeshTopology& mesh, std::size_t loops) {
@@ -459,6 +468,8 @@ reconstruct(Triangulation& dt,
         chosen.resize(REOPENED_LOOPS);
       }
       const std::set<std::vector<int>> shortest(chosen.begin(), chosen.end());
+      const double reach =
+          std::max(REOPENED_REACH, REOPENED_SIGMAS * result.noise_level);
       // One advancing front for every attempt, over the samples in no triangle and
       // the loops' surroundings as far as they are reopened: remade for each, it
       // took 90 % of the time (twenty loops on a noisy FinalBaseMesh: 16 s).
@@ -539,7 +550,7 @@ reconstruct(Triangulation& dt,
             if (result.border_loops.size() < loops.size()) {
               const std::size_t patched = result.triangles.size();
               const bool inserted = insertLeftOut(
-                  dt.points, spacing, kept, result.triangles, region, REOPENED_REACH);
+                  dt.points, spacing, kept, result.triangles, region, reach);
               if (result.triangles.size() != patched) {
                 incidences = EdgeIncidences(result.triangles);
                 result.border_loops = boundaryLoops(incidences, n);
