@@ -408,7 +408,9 @@ eulerCharacteristic(const std::vector<Triangle>& triangles)
 }
 
 /** The cycles of directed edges that leave each vertex once, each as its vertices
- * in order; \a closed false if one ends open (it is cut short there). */
+ * in order; \a closed false if one ends open (it is cut short there, its last
+ * vertex not joined to its first): at a vertex no edge leaves, or at an edge walked
+ * already that is not the cycle's first (two edges enter a vertex there). */
 std::vector<std::vector<int>>
 directedCycles(std::vector<DirectedEdge> edges, bool* closed = nullptr)
 {
@@ -426,12 +428,13 @@ directedCycles(std::vector<DirectedEdge> edges, bool* closed = nullptr)
           std::lower_bound(edges.begin(),
                            edges.end(),
                            DirectedEdge{edges[j][1], std::numeric_limits<int>::min()});
-      if (next == edges.end() || (*next)[0] != edges[j][1]) {
+      const auto at = static_cast<std::size_t>(next - edges.begin());
+      if (next == edges.end() || (*next)[0] != edges[j][1] || (walked[at] && at != i)) {
         if (closed)
           *closed = false;
         break;
       }
-      j = static_cast<std::size_t>(next - edges.begin());
+      j = at;
     }
   }
   return cycles;
