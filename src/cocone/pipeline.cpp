@@ -150,9 +150,6 @@ unmeshedParts(const std::vector<Eigen::Vector3d>& points,
 {
   const std::size_t n = points.size();
   const std::vector<std::uint8_t> meshed = usedVertices(triangles, n);
-  if (2 * static_cast<std::size_t>(std::count(meshed.begin(), meshed.end(), 0)) <
-      MIN_UNMESHED_PART)
-    return std::vector<std::uint8_t>();
   // The mesh's pieces first; the parts join them with the co-cone triangles. Each
   // of the mesh's triangles is then in one part, and taking out a part's leaves the
   // others' fans whole.
@@ -164,14 +161,28 @@ unmeshedParts(const std::vector<Eigen::Vector3d>& points,
   for (const auto& t : triangles)
     join(t);
   // Each piece's size is kept at its root, the only vertex with a nonzero count.
-  std::vector<std::size_t> piece(n, 0);
-  for (std::size_t v = 0; v < n; ++v)
-    piece[parts.find(static_cast<int>(v))] += meshed[v];
+  // 32 bits hold any count: the triangulation indexes the points with int.
+  std::vector<std::uint32_t> piece(n, 0);
+  std::size_t unmeshed = 0, pieces = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const int root = parts.find(static_cast<int>(v));
+    pieces += meshed[v] && piece[root] == 0;
+    piece[root] += meshed[v];
+    unmeshed += !meshed[v];
+  }
+  // No part can be selected without the co-cone triangles' pass (the clean cloud's
+  // case): one of MIN_UNMESHED_PART points that the mesh uses fewer than
+  // MESHED_PART_SHARE of holds that many unmeshed points, and with at most two
+  // pieces the larger holds half of a part's meshed points, more than
+  // BROKEN_PART_SHARE of it.
+  if (static_cast<double>(unmeshed) < (1.0 - MESHED_PART_SHARE) * MIN_UNMESHED_PART &&
+      pieces <= 2)
+    return std::vector<std::uint8_t>();
   for (const auto& t : cocone_triangles)
     if (detail::triangleWithinReach(points, spacing, detail::FAR_NEIGHBOUR, t.v))
       join(t.v);
   // Per part (its root): its points, those the mesh uses and its largest piece.
-  std::vector<std::size_t> size(n, 0), used(n, 0), largest(n, 0);
+  std::vector<std::uint32_t> size(n, 0), used(n, 0), largest(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
     const int root = parts.find(static_cast<int>(v));
     ++size[root];
