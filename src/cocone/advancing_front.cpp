@@ -167,14 +167,22 @@ analyzeOn(const std::vector<int>& vertex, std::vector<Triangle> triangles)
 
 std::vector<Triangle>
 advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<std::uint8_t>& region,
+                   const std::vector<int>& island,
                    int threads)
 {
-  std::vector<int> vertex;
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (region[v])
-      vertex.push_back(static_cast<int>(v));
-  return advancingFront(points, vertex, threads);
+  std::vector<std::vector<int>> vertices;
+  for (std::size_t v = 0; v < island.size(); ++v)
+    if (island[v] >= 0) {
+      if (static_cast<std::size_t>(island[v]) >= vertices.size())
+        vertices.resize(island[v] + 1);
+      vertices[island[v]].push_back(static_cast<int>(v));
+    }
+  std::vector<Triangle> triangles;
+  for (const std::vector<int>& vertex : vertices) {
+    const std::vector<Triangle> part = advancingFront(points, vertex, threads);
+    triangles.insert(triangles.end(), part.begin(), part.end());
+  }
+  return triangles;
 }
 
 HoleFilling

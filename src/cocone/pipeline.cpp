@@ -391,6 +391,30 @@ reconstruct(Triangulation& dt,
       }
       return region;
     };
+    // The region's islands for the advancing front (advancingFrontMesh()): its
+    // points joined by the triangles grow() follows, numbered in the order of their
+    // lowest vertex (the root: the sets keep the lowest).
+    const auto islands = [&](const std::vector<std::uint8_t>& region) {
+      detail::DisjointSets sets(region.size());
+      const auto join = [&](const auto& corners) {
+        for (int i = 0; i < 3; ++i)
+          if (region[corners[i]] && region[corners[(i + 1) % 3]])
+            sets.unite(corners[i], corners[(i + 1) % 3]);
+      };
+      for (const auto& t : cells.triangles)
+        if (detail::triangleWithinReach(dt.points, spacing, detail::FAR_NEIGHBOUR, t.v))
+          join(t.v);
+      for (const auto& t : result.triangles)
+        join(t);
+      std::vector<int> island(region.size(), -1);
+      int count = 0;
+      for (std::size_t v = 0; v < region.size(); ++v)
+        if (region[v]) {
+          const int root = sets.find(static_cast<int>(v));
+          island[v] = root == static_cast<int>(v) ? count++ : island[root];
+        }
+      return island;
+    };
     const auto open_region = [&](int rings, bool free_points, bool with_loops = true) {
       std::vector<std::uint8_t> region(dt.points.size(), free_points ? 1 : 0);
       for (const auto& t : result.triangles)
@@ -517,7 +541,7 @@ reconstruct(Triangulation& dt,
       const std::vector<std::uint8_t> front_region =
           loops_region(chosen, ADVANCING_FRONT_RINGS + REOPENED_RINGS);
       const std::vector<Triangle> front =
-          advancingFrontMesh(dt.points, front_region, threads);
+          advancingFrontMesh(dt.points, islands(front_region), threads);
       // Its triangles within FRONT_RINGS of a reopened region: the patches' and
       // the bands' (the whole front, matched against every loop, took 60 % of the
       // time).
@@ -618,16 +642,18 @@ reconstruct(Triangulation& dt,
     // closes the loops together, before the patches below cap each on its own.
     std::vector<std::uint8_t> region = open_region(ADVANCING_FRONT_RINGS, true, false);
     if (!region.empty())
-      fill_from(
-          advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE, true);
+      fill_from(advancingFrontMesh(dt.points, islands(region), threads),
+                BAND_PER_LOOP_EDGE,
+                true);
     patch_loops(HoleWeight::DIHEDRAL_ANGLES, 0.0);
     region = open_region(PLAIN_COCONE_RINGS, true);
     if (!region.empty())
       fill_from(plainCoconeMesh(dt.points, cells, region, threads), 0, false);
     region = open_region(ADVANCING_FRONT_RINGS, false);
     if (!region.empty())
-      fill_from(
-          advancingFrontMesh(dt.points, region, threads), BAND_PER_LOOP_EDGE, false);
+      fill_from(advancingFrontMesh(dt.points, islands(region), threads),
+                BAND_PER_LOOP_EDGE,
+                false);
     // What the walk left between sheets a couple of spacings apart, closed by the
     // patches or not, is no surface: the specks go, with their loops and holes.
     counts.repair.speck =

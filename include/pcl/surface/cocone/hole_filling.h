@@ -204,17 +204,19 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<std::uint8_t>& true_border = {});
 
 /** \brief CGAL's advancing front reconstruction (Cohen-Steiner and Da; CGAL's
- * default plausibility: radius ratio bound 5, beta 0.52) of the points \a region
- * marks, made an oriented manifold by repairManifold(); the triangles index
- * \a points.
+ * default plausibility: radius ratio bound 5, beta 0.52) of the points \a island
+ * labels, one run per label (-1: no island), made an oriented manifold by
+ * repairManifold(); the triangles index \a points.
  *
  * Where the sampling is too coarse for the co-cones (a thin part, a crease, the
  * vertex density changing several times over a few spacings), the advancing
  * front still grows triangles as large as their neighbours': a patch source for
- * fillHolesFromMesh(). */
+ * fillHolesFromMesh(). One run per island of the region rather than one over it
+ * all: CGAL's front seeds each of its connected components with a scan of every
+ * Delaunay facet, so one run over many islands takes the time of their product. */
 std::vector<Triangle>
 advancingFrontMesh(const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<std::uint8_t>& region,
+                   const std::vector<int>& island,
                    int threads = 1);
 
 /** \brief Close whole pieces of the mesh that the patches leave open: a piece
