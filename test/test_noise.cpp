@@ -535,6 +535,35 @@ TEST(Noise, RangeViewsOfOtherOpenSurfaces)
   }
 }
 
+TEST(Noise, BothScalesAtOnceGiveTheSameOutput)
+{
+  // Where the displacements do not tell, both scales are reconstructed, at once
+  // given two threads or more: the smoothed one kept (the noisy coarse tube above)
+  // and the given one (the heavy-tailed spheres above), the same on any threads.
+  SampleOptions tube = options(8000, 0.5, 1.0, true);
+  tube.seed = 1;
+  for (const Sample& s :
+       {cocone_test::tube(tube, 0.07),
+        cocone_test::twoTouchingSpheres(options(4000, 0.1, 1.0, true))}) {
+    SCOPED_TRACE(s.name);
+    Parameters one;
+    one.threads = 1;
+    const Result a = reconstruct(s.points, one);
+    EXPECT_EQ(a.smoothed, s.name != "two_touching_spheres");
+    for (const unsigned int threads : {2u, 3u}) {
+      Parameters more;
+      more.threads = threads;
+      const Result b = reconstruct(s.points, more);
+      EXPECT_EQ(a.smoothed, b.smoothed);
+      EXPECT_EQ(a.outlier_indices, b.outlier_indices);
+      EXPECT_EQ(a.boundary_indices, b.boundary_indices);
+      EXPECT_EQ(a.triangles, b.triangles);
+      EXPECT_EQ(a.border_loops, b.border_loops);
+      EXPECT_EQ(a.filled_holes, b.filled_holes);
+    }
+  }
+}
+
 TEST(Noise, SameOutputOnAnyThreads)
 {
   const Sample s = cocone_test::hemisphere(options(10000, 0.5, 1.0, false));

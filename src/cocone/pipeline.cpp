@@ -28,11 +28,13 @@
 #include "stopwatch.h"
 
 #include <algorithm>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <new>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <utility>
 
 namespace pcl {
@@ -638,6 +640,47 @@ completeStages(Triangulation& dt,
   }
 }
 
+/** first() and second(), on two threads if \a at_once (else, or if no second
+ * thread can be started, one after the other); what either throws is thrown once
+ * both are done. */
+template <typename First, typename Second>
+void
+bothAtOnce(const First& first, const Second& second, bool at_once)
+{
+  if (!at_once) {
+    first();
+    second();
+    return;
+  }
+  std::exception_ptr failed;
+  std::thread other;
+  try {
+    other = std::thread([&] {
+      try {
+        second();
+      }
+      catch (...) {
+        failed = std::current_exception();
+      }
+    });
+  }
+  catch (const std::system_error&) {
+    first();
+    second();
+    return;
+  }
+  try {
+    first();
+  }
+  catch (...) {
+    other.join();
+    throw;
+  }
+  other.join();
+  if (failed)
+    std::rethrow_exception(failed);
+}
+
 /** The counted vertices (countedVertices()) that a run's mesh leaves out or has on
  * its border. */
 std::size_t
@@ -713,11 +756,24 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   alternative.vertices = smoothed->vertices;
   alternative.offset = smoothed->dt.offset;
   alternative.smoothed = true;
-  completeStages(dt, cells, parameters, stages, ids, threads, result);
-  const double given_ms = clock.lap();
-  completeStages(
-      smoothed->dt, smoothed->cells, parameters, stages, ids, threads, alternative);
-  const double smoothed_ms = clock.lap();
+  // The two scales are independent: given two threads or more they run at once,
+  // half the threads each (the output is the same whatever the thread count).
+  const int share = threads >= 2 ? threads / 2 : threads;
+  Parameters shared = parameters;
+  shared.threads = static_cast<unsigned int>(share);
+  double given_ms = 0.0, smoothed_ms = 0.0;
+  const auto given_scale = [&] {
+    detail::Stopwatch watch;
+    completeStages(dt, cells, shared, stages, ids, share, result);
+    given_ms = watch.lap();
+  };
+  const auto smoothed_scale = [&] {
+    detail::Stopwatch watch;
+    completeStages(
+        smoothed->dt, smoothed->cells, shared, stages, ids, share, alternative);
+    smoothed_ms = watch.lap();
+  };
+  bothAtOnce(given_scale, smoothed_scale, threads >= 2);
   const bool smoothing_wins =
       static_cast<double>(unresolvedVertices(parameters, alternative)) <=
       UNRESOLVED_SHARE * static_cast<double>(unresolvedVertices(parameters, result));

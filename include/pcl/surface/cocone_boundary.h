@@ -206,7 +206,9 @@ public:
    *
    * The output does not depend on it. The Delaunay triangulation (from about ten
    * thousand points a thread), the passes over the Voronoi cells, the half-disk test
-   * and most of the reconstruction run in parallel; the walk on one thread.
+   * and most of the reconstruction run in parallel; the walk on one thread. Where a
+   * noisy cloud is reconstructed at both scales (see setNoiseHandling()), the two
+   * run at once, half the threads each (both in memory together).
    * \param[in] nr_threads number of threads, 0 for all (default 1)
    */
   void
