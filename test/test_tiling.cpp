@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include <support/cases.h>
+#include <support/expect.h>
 #include <support/surfaces.h>
 
 #include <algorithm>
@@ -554,35 +555,6 @@ TEST(TilingClass, SetTilePoints)
   EXPECT_EQ(normals.size(), cloud->size());
 }
 
-/** The same bits (NaN equal to NaN). */
-template <typename T>
-bool
-sameBits(const std::vector<T>& a, const std::vector<T>& b)
-{
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-void
-expectSameResult(const Result& a, const Result& b)
-{
-  EXPECT_EQ(a.error, b.error);
-  EXPECT_EQ(a.polygons, b.polygons);
-  EXPECT_EQ(a.triangles, b.triangles);
-  EXPECT_EQ(a.border_loops, b.border_loops);
-  EXPECT_EQ(a.filled_holes, b.filled_holes);
-  EXPECT_EQ(a.boundary_indices, b.boundary_indices);
-  EXPECT_EQ(a.outlier_indices, b.outlier_indices);
-  EXPECT_EQ(a.vertex_of_input, b.vertex_of_input);
-  EXPECT_EQ(a.representative, b.representative);
-  EXPECT_TRUE(sameBits(a.positions, b.positions));
-  EXPECT_TRUE(sameBits(a.normals, b.normals));
-  EXPECT_TRUE(sameBits(a.point_noise, b.point_noise));
-  EXPECT_EQ(a.offset, b.offset);
-  EXPECT_EQ(a.ratio, b.ratio);
-  EXPECT_EQ(a.noise_level, b.noise_level);
-}
-
 TEST(TilingPhases, ComposedByHandEqualRunTiled)
 {
   // Caller ids not the positions, a few non-finite points and duplicates.
@@ -647,7 +619,7 @@ TEST(TilingPhases, ComposedByHandEqualRunTiled)
   TilingReport report;
   const Result stitched =
       pcl::cocone::stitchTiles(plan, results, parameters, ids, &report);
-  expectSameResult(stitched, whole);
+  cocone_test::expectSameResult(stitched, whole);
   EXPECT_EQ(report.point_tile, whole_report.point_tile);
   EXPECT_EQ(report.triangle_tile, whole_report.triangle_tile);
   EXPECT_EQ(report.halo_points, whole_report.halo_points);

@@ -10,6 +10,8 @@
 #include <support/metrics.h>
 
 #include <cstddef>
+#include <cstring>
+#include <vector>
 
 namespace cocone_test {
 
@@ -26,6 +28,36 @@ closedSurface(const MeshScore& m, std::size_t components, long euler)
   return ::testing::AssertionFailure()
          << "expected a closed oriented surface of " << components
          << " component(s), Euler " << euler << "; got " << m.str();
+}
+
+/** The same bits (NaN equal to NaN). */
+template <typename T>
+bool
+sameBits(const std::vector<T>& a, const std::vector<T>& b)
+{
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+/** \brief Expect two results to be the same, bit for bit where they hold numbers. */
+inline void
+expectSameResult(const pcl::cocone::Result& a, const pcl::cocone::Result& b)
+{
+  EXPECT_EQ(a.error, b.error);
+  EXPECT_EQ(a.polygons, b.polygons);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.border_loops, b.border_loops);
+  EXPECT_EQ(a.filled_holes, b.filled_holes);
+  EXPECT_EQ(a.boundary_indices, b.boundary_indices);
+  EXPECT_EQ(a.outlier_indices, b.outlier_indices);
+  EXPECT_EQ(a.vertex_of_input, b.vertex_of_input);
+  EXPECT_EQ(a.representative, b.representative);
+  EXPECT_TRUE(sameBits(a.positions, b.positions));
+  EXPECT_TRUE(sameBits(a.normals, b.normals));
+  EXPECT_TRUE(sameBits(a.point_noise, b.point_noise));
+  EXPECT_EQ(a.offset, b.offset);
+  EXPECT_EQ(a.ratio, b.ratio);
+  EXPECT_EQ(a.noise_level, b.noise_level);
 }
 
 } // namespace cocone_test
