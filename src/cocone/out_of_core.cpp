@@ -26,7 +26,6 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <new>
 #include <string>
 #include <system_error>
@@ -549,46 +548,30 @@ private:
         tiling_.tiles_in_flight > 0 ? tiling_.tiles_in_flight : threads_, count_));
     Parameters tile_parameters = parameters_;
     tile_parameters.threads = static_cast<unsigned>(std::max(1, threads_ / in_flight));
-    std::mutex failure;
-    std::string error;
-    bool out_of_memory = false;
-    detail::forEachTile(count_, in_flight, [&](std::size_t t) {
-      try {
-        const TileFiles files = work_.tile(t);
-        std::vector<Record> records = readRecords(files.core);
-        const std::vector<Record> halo = readRecords(files.halo);
-        records.insert(records.end(), halo.begin(), halo.end());
-        std::vector<Eigen::Vector3d> points(records.size());
-        std::vector<int> ids(records.size());
-        for (std::size_t i = 0; i < records.size(); ++i) {
-          points[i] = {records[i].x, records[i].y, records[i].z};
-          ids[i] = static_cast<int>(records[i].id);
-        }
-        const std::vector<int> core(
-            ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(core_size_[t]));
-        std::vector<Record>().swap(records);
-        const TileResult o =
-            reconstructTile(std::move(points), ids, core_size_[t], tile_parameters);
-        if (!o.error.empty())
-          throw IoError("tile " + std::to_string(t) + ": " + o.error);
-        writeResult(files, core, o);
-        fs::remove(files.core);
-        fs::remove(files.halo);
+    // A tile that fails (out of memory, a file that cannot be read or written) ends
+    // the run with its error.
+    detail::forEachTask(count_, in_flight, [&](std::size_t t) {
+      const TileFiles files = work_.tile(t);
+      std::vector<Record> records = readRecords(files.core);
+      const std::vector<Record> halo = readRecords(files.halo);
+      records.insert(records.end(), halo.begin(), halo.end());
+      std::vector<Eigen::Vector3d> points(records.size());
+      std::vector<int> ids(records.size());
+      for (std::size_t i = 0; i < records.size(); ++i) {
+        points[i] = {records[i].x, records[i].y, records[i].z};
+        ids[i] = static_cast<int>(records[i].id);
       }
-      catch (const std::bad_alloc&) {
-        std::lock_guard<std::mutex> lock(failure);
-        out_of_memory = true;
-      }
-      catch (const std::exception& e) { // must not leave the thread
-        std::lock_guard<std::mutex> lock(failure);
-        if (error.empty())
-          error = e.what();
-      }
+      const std::vector<int> core(
+          ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(core_size_[t]));
+      std::vector<Record>().swap(records);
+      const TileResult o =
+          reconstructTile(std::move(points), ids, core_size_[t], tile_parameters);
+      if (!o.error.empty())
+        throw IoError("tile " + std::to_string(t) + ": " + o.error);
+      writeResult(files, core, o);
+      fs::remove(files.core);
+      fs::remove(files.halo);
     });
-    if (out_of_memory)
-      throw std::bad_alloc();
-    if (!error.empty())
-      throw IoError(error);
   }
 
   // ---- The stitch ----------------------------------------------------------------

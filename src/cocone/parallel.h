@@ -2,8 +2,8 @@
  * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
- * Splitting a loop among threads, a counting sort on them, and sets that threads
- * unite at once (not installed).
+ * Splitting a loop among threads, tasks handed to the first thread free, a counting
+ * sort on them, and sets that threads unite at once (not installed).
  */
 
 #pragma once
@@ -13,9 +13,15 @@
 #endif
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
+#include <limits>
+#include <mutex>
 #include <new>
+#include <system_error>
+#include <thread>
 #include <vector>
 
 namespace pcl {
@@ -59,6 +65,56 @@ forEachRange(std::size_t count, int parts, const Body& body)
   }
   if (failed)
     throw std::bad_alloc();
+}
+
+/** Run body(t) for every task t in [0, count) on up to \a workers threads, the
+ * caller's one of them, the next task to the first thread free. What a task throws
+ * stops the handing out of tasks and is thrown here once every thread is done: an
+ * exception must not leave a thread. The tasks go out in ascending order, so every
+ * task below a failed one has run, and what is thrown is the lowest failing task's,
+ * whatever the threads. A thread the system does not grant leaves its tasks to the
+ * others. */
+template <typename Body>
+void
+forEachTask(std::size_t count, int workers, const Body& body)
+{
+  std::atomic<std::size_t> next{0};
+  std::mutex failing;
+  std::exception_ptr failure;
+  std::size_t failed = std::numeric_limits<std::size_t>::max();
+  const auto work = [&] {
+    for (std::size_t t = next++; t < count; t = next++) {
+      try {
+        body(t);
+      }
+      catch (...) {
+        const std::lock_guard<std::mutex> lock(failing);
+        if (t < failed) {
+          failed = t;
+          failure = std::current_exception();
+        }
+        next = count;
+      }
+    }
+  };
+  // The caller works too: workers - 1 threads more, none beyond the tasks.
+  const std::size_t extra = std::min<std::size_t>(
+      static_cast<std::size_t>(std::max(workers, 1)) - 1, count > 0 ? count - 1 : 0);
+  std::vector<std::thread> pool;
+  try {
+    pool.reserve(extra);
+    while (pool.size() < extra)
+      pool.emplace_back(work);
+  }
+  catch (const std::system_error&) {
+  }
+  catch (const std::bad_alloc&) {
+  }
+  work();
+  for (auto& thread : pool)
+    thread.join();
+  if (failure)
+    std::rethrow_exception(failure);
 }
 
 /** A stable counting sort of the items [0, count) by key(i), below \a buckets: calls

@@ -23,18 +23,17 @@
 #include "caller_ids.h"
 #include "disjoint_sets.h"
 #include "edge_sort.h"
+#include "parallel.h"
 #include "points.h"
 #include "stages.h"
 #include "stopwatch.h"
 
 #include <algorithm>
-#include <exception>
 #include <limits>
 #include <memory>
 #include <new>
 #include <string>
 #include <system_error>
-#include <thread>
 #include <utility>
 
 namespace pcl {
@@ -640,47 +639,6 @@ completeStages(Triangulation& dt,
   }
 }
 
-/** first() and second(), on two threads if \a at_once (else, or if no second
- * thread can be started, one after the other); what either throws is thrown once
- * both are done. */
-template <typename First, typename Second>
-void
-bothAtOnce(const First& first, const Second& second, bool at_once)
-{
-  if (!at_once) {
-    first();
-    second();
-    return;
-  }
-  std::exception_ptr failed;
-  std::thread other;
-  try {
-    other = std::thread([&] {
-      try {
-        second();
-      }
-      catch (...) {
-        failed = std::current_exception();
-      }
-    });
-  }
-  catch (const std::system_error&) {
-    first();
-    second();
-    return;
-  }
-  try {
-    first();
-  }
-  catch (...) {
-    other.join();
-    throw;
-  }
-  other.join();
-  if (failed)
-    std::rethrow_exception(failed);
-}
-
 /** The counted vertices (countedVertices()) that a run's mesh leaves out or has on
  * its border. */
 std::size_t
@@ -773,7 +731,9 @@ runStages(std::vector<Eigen::Vector3d>&& points,
         smoothed->dt, smoothed->cells, shared, stages, ids, share, alternative);
     smoothed_ms = watch.lap();
   };
-  bothAtOnce(given_scale, smoothed_scale, threads >= 2);
+  detail::forEachTask(2, threads >= 2 ? 2 : 1, [&](std::size_t scale) {
+    scale == 0 ? given_scale() : smoothed_scale();
+  });
   const bool smoothing_wins =
       static_cast<double>(unresolvedVertices(parameters, alternative)) <=
       UNRESOLVED_SHARE * static_cast<double>(unresolvedVertices(parameters, result));

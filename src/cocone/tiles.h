@@ -15,11 +15,9 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -254,37 +252,6 @@ add(Timings& a, const Timings& b);
 /** The median of \a v (its upper middle element), 0 if empty. */
 double
 median(std::vector<double> v);
-
-/** Run \a body(t) for t in [0, count) on up to \a workers threads, each tile on one
- * of them, the next tile to the first thread free. */
-template <typename Body>
-void
-forEachTile(std::size_t count, int workers, const Body& body)
-{
-  if (workers <= 1) {
-    for (std::size_t t = 0; t < count; ++t)
-      body(t);
-    return;
-  }
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t t = next++; t < count; t = next++)
-      body(t);
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(workers));
-  try {
-    for (int w = 0; w < workers; ++w)
-      pool.emplace_back(work);
-  }
-  catch (...) { // a thread that could not start: the others finish the tiles
-    for (auto& thread : pool)
-      thread.join();
-    throw;
-  }
-  for (auto& thread : pool)
-    thread.join();
-}
 
 /** Whether the stitch closes a hole of three edges by its own triangle \a t (ids
  * ascending, none of the tiles kept it): its edges are border edges and it lies on a

@@ -233,7 +233,7 @@ namespace {
 using detail::add;
 using detail::Box;
 using detail::distinctHoles;
-using detail::forEachTile;
+using detail::forEachTask;
 using detail::median;
 using detail::medianSpacing;
 using detail::SEAM_HOLE_EDGES;
@@ -794,27 +794,18 @@ planTiles(const std::vector<Eigen::Vector3d>& points,
     // The halo of each tile: the points within its reach, which is measured on its
     // own core's spacing.
     plan.halo.resize(count);
-    std::atomic<bool> out_of_memory{false};
     const int threads = resolveThreads(parameters.threads);
-    forEachTile(count,
+    forEachTask(count,
                 static_cast<int>(std::min<std::size_t>(threads, count)),
                 [&](std::size_t t) {
-                  try {
-                    const auto& core = tiles.core(t);
-                    const double reach =
-                        tiling.halo_spacings *
-                        medianSpacing(points,
-                                      tiles.order().data() + core.begin,
-                                      core.end - core.begin,
-                                      core.box);
-                    plan.halo[t] = tiles.halo(t, reach);
-                  }
-                  catch (const std::bad_alloc&) { // must not leave the thread
-                    out_of_memory = true;
-                  }
+                  const auto& core = tiles.core(t);
+                  const double reach = tiling.halo_spacings *
+                                       medianSpacing(points,
+                                                     tiles.order().data() + core.begin,
+                                                     core.end - core.begin,
+                                                     core.box);
+                  plan.halo[t] = tiles.halo(t, reach);
                 });
-    if (out_of_memory)
-      throw std::bad_alloc();
     plan.order = tiles.takeOrder();
     plan.cut_ms = clock.lap();
   }
@@ -1089,7 +1080,7 @@ runTiled(std::vector<Eigen::Vector3d> points,
     Parameters tile_parameters = parameters;
     tile_parameters.threads = static_cast<unsigned>(std::max(1, threads / in_flight));
     std::vector<TileResult> results(count);
-    forEachTile(count, in_flight, [&](std::size_t t) {
+    forEachTask(count, in_flight, [&](std::size_t t) {
       results[t] = reconstructTile(plan, t, points, tile_parameters, ids);
     });
     const double tiles_ms = clock.lap();
