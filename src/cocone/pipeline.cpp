@@ -132,12 +132,11 @@ constexpr double MESHED_PART_SHARE = 0.9;
  * the original Co-cone makes of it is the best guess there is, and its holes are then
  * closed like the walk's. Empty if there is none. */
 std::vector<std::uint8_t>
-unmeshedParts(const std::vector<Eigen::Vector3d>& points,
-              const std::vector<double>& spacing,
+unmeshedParts(std::size_t n,
               const std::vector<CoconeTriangle>& cocone_triangles,
+              detail::CoconeTrianglesWithinReach& within_reach,
               const std::vector<Triangle>& triangles)
 {
-  const std::size_t n = points.size();
   const std::vector<std::uint8_t> meshed = usedVertices(triangles, n);
   // The mesh's pieces first; the parts join them with the co-cone triangles. Each
   // of the mesh's triangles is then in one part, and taking out a part's leaves the
@@ -167,9 +166,10 @@ unmeshedParts(const std::vector<Eigen::Vector3d>& points,
   if (static_cast<double>(unmeshed) < (1.0 - MESHED_PART_SHARE) * MIN_UNMESHED_PART &&
       pieces <= 2)
     return std::vector<std::uint8_t>();
-  for (const auto& t : cocone_triangles)
-    if (detail::triangleWithinReach(points, spacing, detail::FAR_NEIGHBOUR, t.v))
-      join(t.v);
+  const std::vector<std::uint8_t>& reach = within_reach.mask();
+  for (std::size_t i = 0; i < cocone_triangles.size(); ++i)
+    if (reach[i])
+      join(cocone_triangles[i].v);
   // Per part (its root): its points, those the mesh uses and its largest piece.
   std::vector<std::uint32_t> size(n, 0), used(n, 0), largest(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
@@ -200,6 +200,7 @@ walkSurface(Triangulation& dt,
             const Parameters& parameters,
             const std::vector<double>& rim_reach,
             const std::vector<double>& spacing,
+            detail::CoconeTrianglesWithinReach& within_reach,
             Result& result)
 {
   auto& counts = result.counts;
@@ -236,8 +237,8 @@ walkSurface(Triangulation& dt,
   }
   counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size(), &incidences);
   if (parameters.fill_undersampled_holes && !spacing.empty()) {
-    const std::vector<std::uint8_t> unmeshed =
-        unmeshedParts(dt.points, spacing, cells.triangles, result.triangles);
+    const std::vector<std::uint8_t> unmeshed = unmeshedParts(
+        dt.points.size(), cells.triangles, within_reach, result.triangles);
     if (!unmeshed.empty()) {
       // The walk's triangles there (all their corners in the part) make way for
       // the Co-cone's over the whole part: the mesh stays an oriented manifold.
@@ -608,10 +609,22 @@ completeStages(Triangulation& dt,
 
   result.umbrella_failed.assign(result.vertices, 0);
   if (stages == Stages::RECONSTRUCTION) {
-    EdgeIncidences incidences = walkSurface(
-        dt, cells, parameters, undersampling.rim_reach, undersampling.spacing, result);
-    detail::closeUndersampledHoles(
-        dt.points, cells, parameters, undersampling.spacing, incidences, result);
+    detail::CoconeTrianglesWithinReach within_reach(
+        dt.points, undersampling.spacing, cells.triangles);
+    EdgeIncidences incidences = walkSurface(dt,
+                                            cells,
+                                            parameters,
+                                            undersampling.rim_reach,
+                                            undersampling.spacing,
+                                            within_reach,
+                                            result);
+    detail::closeUndersampledHoles(dt.points,
+                                   cells,
+                                   parameters,
+                                   undersampling.spacing,
+                                   within_reach,
+                                   incidences,
+                                   result);
     finishMesh(dt, cells, threads, result);
     result.timings.reconstruction = clock.lap();
   }

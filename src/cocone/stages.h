@@ -11,12 +11,47 @@
 
 #include <Eigen/Core>
 
+#include "points.h"
+
 #include <cstdint>
 #include <vector>
 
 namespace pcl {
 namespace cocone {
 namespace detail {
+
+/** Which co-cone triangles have every edge within FAR_NEIGHBOUR spacings
+ * (triangleWithinReach()): those the undersampled holes' stage follows over the
+ * surface (the unmeshed parts, the rings round a hole, the islands), not those along
+ * the convex hull or across a wide void. Read at the first need, then kept: a clean
+ * cloud has no hole to follow them round. */
+class CoconeTrianglesWithinReach {
+public:
+  CoconeTrianglesWithinReach(const std::vector<Eigen::Vector3d>& points,
+                             const std::vector<double>& spacing,
+                             const std::vector<CoconeTriangle>& triangles)
+  : points_(points), spacing_(spacing), triangles_(triangles)
+  {}
+
+  /** Per co-cone triangle (as \a triangles orders them), 1 if within reach. */
+  const std::vector<std::uint8_t>&
+  mask()
+  {
+    if (mask_.empty() && !triangles_.empty()) {
+      mask_.resize(triangles_.size());
+      for (std::size_t i = 0; i < triangles_.size(); ++i)
+        mask_[i] =
+            triangleWithinReach(points_, spacing_, FAR_NEIGHBOUR, triangles_[i].v);
+    }
+    return mask_;
+  }
+
+private:
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<double>& spacing_;
+  const std::vector<CoconeTriangle>& triangles_;
+  std::vector<std::uint8_t> mask_;
+};
 
 /** Stages 5-7 and the repair over stage 4's candidates: the oriented manifold
  * mesh, its edge incidences, and per vertex whether it failed the umbrella check. */
@@ -45,13 +80,15 @@ plainCoconeMesh(const std::vector<Eigen::Vector3d>& points,
 
 /** The undersampled holes of the walk's mesh (result.triangles, its edges
  * \a incidences and its loops result.border_loops) closed, its true borders kept
- * (Parameters::fill_undersampled_holes); \a spacing per vertex its local spacing.
- * Nothing if the option is off or \a spacing is empty. */
+ * (Parameters::fill_undersampled_holes); \a spacing per vertex its local spacing,
+ * \a within_reach over \a cells' triangles. Nothing if the option is off or
+ * \a spacing is empty. */
 void
 closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                        const VoronoiCells& cells,
                        const Parameters& parameters,
                        const std::vector<double>& spacing,
+                       CoconeTrianglesWithinReach& within_reach,
                        EdgeIncidences& incidences,
                        Result& result);
 

@@ -90,6 +90,7 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                        const VoronoiCells& cells,
                        const Parameters& parameters,
                        const std::vector<double>& spacing,
+                       CoconeTrianglesWithinReach& within_reach,
                        EdgeIncidences& incidences,
                        Result& result)
 {
@@ -147,25 +148,12 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
   // coarsely for the flatness test. What those leave, the advancing front's may:
   // the vertex density changing faster than the co-cones follow. Only there, and
   // a few rings around, does either mesh need making.
-  // The rings grow through co-cone triangles of the surface round the holes, not
-  // through those along the convex hull or across a wide void (an edge of more
-  // than FAR_NEIGHBOUR spacings): at a tile's cut those reached over most of the
-  // tile (75,000 of 128,000 points for a 1M saddle's tile of 125,000, the
-  // advancing front then taking 44 % of its time).
-  // Which co-cone triangles the rings and the islands follow: read once, at the
-  // first need (a clean cloud has no loop to grow round).
-  std::vector<std::uint8_t> within_reach;
-  const auto reach_mask = [&]() -> const std::vector<std::uint8_t>& {
-    if (within_reach.empty() && !cells.triangles.empty()) {
-      within_reach.resize(cells.triangles.size());
-      for (std::size_t i = 0; i < cells.triangles.size(); ++i)
-        within_reach[i] =
-            triangleWithinReach(points, spacing, FAR_NEIGHBOUR, cells.triangles[i].v);
-    }
-    return within_reach;
-  };
+  // The rings grow through co-cone triangles within reach (CoconeTrianglesWithinReach):
+  // at a tile's cut those across a wide void reached over most of the tile (75,000
+  // of 128,000 points for a 1M saddle's tile of 125,000, the advancing front then
+  // taking 44 % of its time).
   const auto grow = [&](std::vector<std::uint8_t> region, int rings) {
-    const std::vector<std::uint8_t>& reach = reach_mask();
+    const std::vector<std::uint8_t>& reach = within_reach.mask();
     for (int ring = 0; ring < rings; ++ring) {
       std::vector<std::uint8_t> grown = region;
       for (std::size_t i = 0; i < cells.triangles.size(); ++i) {
@@ -190,7 +178,7 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
         if (region[corners[i]] && region[corners[(i + 1) % 3]])
           sets.unite(corners[i], corners[(i + 1) % 3]);
     };
-    const std::vector<std::uint8_t>& reach = reach_mask();
+    const std::vector<std::uint8_t>& reach = within_reach.mask();
     for (std::size_t i = 0; i < cells.triangles.size(); ++i)
       if (reach[i])
         join(cells.triangles[i].v);
