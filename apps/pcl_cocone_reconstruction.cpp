@@ -405,6 +405,7 @@ reconstructOutOfCore(const Options& o,
         << ",\n  \"holes_filled\": " << r.holes_filled
         << ",\n  \"hole_triangles\": " << r.counts.hole_triangles
         << ",\n  \"handles_cut\": " << r.counts.handles_cut
+        << ",\n  \"necks_cut\": " << r.counts.necks_cut
         << ",\n  \"added_points\": 0,\n  \"triangles\": " << r.triangles
         << ",\n  \"components\": " << r.components << ",\n  \"euler\": " << r.euler
         << ",\n  \"boundary_loops\": " << r.border_loops.size()
@@ -726,6 +727,7 @@ main(int argc, char** argv)
       << ",\n  \"filled_hole_sizes\": " << jsonList(filled_sizes)
       << ",\n  \"hole_triangles\": " << cocone.getReconstructionCounts().hole_triangles
       << ",\n  \"handles_cut\": " << cocone.getReconstructionCounts().handles_cut
+      << ",\n  \"necks_cut\": " << cocone.getReconstructionCounts().necks_cut
       << ",\n  \"added_points\": " << added.size()
       << ",\n  \"triangles\": " << triangles << ",\n  \"components\": " << components
       << ",\n  \"boundary_loops\": " << loops.size()

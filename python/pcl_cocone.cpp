@@ -482,6 +482,7 @@ toPython(cocone::Result& r,
   counts["holes_filled"] = c.holes_filled;
   counts["hole_triangles"] = c.hole_triangles;
   counts["handles_cut"] = c.handles_cut;
+  counts["necks_cut"] = c.necks_cut;
 
   py::dict& report = out.report;
   report["stages"] = stages == cocone::Stages::RECONSTRUCTION ? "reconstruction"
@@ -581,6 +582,7 @@ eachCount(Counts& c, const F& f)
   f("holes_filled", c.holes_filled);
   f("hole_triangles", c.hole_triangles);
   f("handles_cut", c.handles_cut);
+  f("necks_cut", c.necks_cut);
 }
 
 template <typename Timings, typename F>

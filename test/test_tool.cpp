@@ -187,6 +187,7 @@ TEST_F(Tool, ReportAgreesWithTheLibrary)
                           "\"holes_filled\"",
                           "\"filled_hole_sizes\"",
                           "\"handles_cut\"",
+                          "\"necks_cut\"",
                           "\"timings_ms\"",
                           "\"load\"",
                           "\"delaunay\"",

@@ -134,6 +134,7 @@ add(ReconstructionCounts& a, const ReconstructionCounts& b)
   a.true_borders += b.true_borders;
   a.holes_filled += b.holes_filled;
   a.handles_cut += b.handles_cut;
+  a.necks_cut += b.necks_cut;
   a.hole_triangles += b.hole_triangles;
 }
 

@@ -467,6 +467,26 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
   if (reopen_loops())
     counts.handles_cut += cutShortHandles(
         points, result.triangles, incidences, MIN_TUNNEL_SAMPLES, threads);
+  // Necks too narrow for any sample round them: where the walk joined two bodies
+  // that touch, across sheets closer than the spacing, and the holes round the
+  // join were closed. Searched from the filled holes' rims and the ring round
+  // them (on the touching spheres the neck's cycle runs through a rim).
+  if (!result.filled_holes.empty()) {
+    std::vector<std::uint8_t> rim(points.size(), 0);
+    for (const auto& loop : result.filled_holes)
+      for (const int v : loop)
+        rim[v] = 1;
+    std::vector<std::uint8_t> near = rim;
+    for (const auto& t : result.triangles)
+      if (rim[t[0]] || rim[t[1]] || rim[t[2]])
+        near[t[0]] = near[t[1]] = near[t[2]] = 1;
+    std::vector<int> seeds;
+    for (std::size_t v = 0; v < near.size(); ++v)
+      if (near[v])
+        seeds.push_back(static_cast<int>(v));
+    counts.necks_cut =
+        cutShortNecks(points, result.triangles, incidences, seeds, MIN_TUNNEL_SAMPLES);
+  }
   // The borders left through the samples on them.
   counts.repair.peeled =
       peelBorderSlivers(points, result.triangles, incidences, result.border_loops);

@@ -313,10 +313,13 @@ public:
    * noise, where the walk met two sheets within the noise or a couple of spacings
    * apart): a handle with a non-separating cycle of fewer than 6 edges whose sides
    * meet again within 32 triangles is cut along the cycle and both cuts closed
-   * (getReconstructionCounts().handles_cut). Each loop left (the 24 shortest where
-   * more are left) is reopened by one to three rings of triangles (a crumpled
-   * cluster where two sheets meet within the noise, a handle through the loop) and
-   * the wider hole goes through the passes again; kept only if the loop closes with
+   * (getReconstructionCounts().handles_cut), and so is a neck no sample resolves
+   * (two bodies that touch, which the walk joined: a separating cycle of fewer than
+   * 6 edges round the filled holes, the surface opening out and going on for 32
+   * rings on both sides; getReconstructionCounts().necks_cut). Each loop left (the 24
+   * shortest where more are left) is reopened by one to three rings of triangles (a
+   * crumpled cluster where two sheets meet within the noise, a handle through the loop)
+   * and the wider hole goes through the passes again; kept only if the loop closes with
    * no handle and no piece more and every point it leaves out lies within two local
    * spacings of the new surface, or three sigmas of the cloud's noise
    * (getNoiseLevel()) where that is wider, and goes into its nearest triangle.

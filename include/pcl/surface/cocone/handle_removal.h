@@ -56,5 +56,37 @@ cutShortHandles(const std::vector<Eigen::Vector3d>& points,
                 std::size_t min_tunnel_samples = MIN_TUNNEL_SAMPLES,
                 int threads = 1);
 
+/** \brief Cut the necks no sample resolves: where the walk joined two bodies that
+ * touch, or nearly, it leaves a neck of a few triangles between them (the sheets
+ * closer than the spacing there, the hole filling closes round it). A neck of
+ * radius r has about 2 pi r / s samples round it, as a tunnel has, so one with a
+ * cycle of fewer than \a min_tunnel_samples edges is below what the sample
+ * resolves. The candidates are the cycles of two breadth-first paths from a seed
+ * and an edge, of 3 to \a min_tunnel_samples - 1 edges and off the borders, that
+ * separate the surface (their hash sum is zero: no handle's cycle), from the seeds
+ * whose ball of two rings is no disk (Euler characteristic below 1: round a vertex
+ * of a surface it is a disk, where every cycle bounds); one is a neck
+ * where the surface opens out on both sides and grows on as a surface (the sixth
+ * ring of triangles round it holds at least twice the first's, the twelfth 1.4
+ * times the sixth's: a coarse tube's rings stay alike) and goes on for 32 rings on
+ * each (a body of its own, not a blister noise pinched off). Each is cut as a
+ * handle is, the shortest first: the two sides become components of their own,
+ * closed by least-perimeter patches of their vertices. Every vertex stays in the
+ * mesh, which stays an oriented 2-manifold; its borders are unchanged.
+ * \param[in] points vertex positions
+ * \param[in,out] triangles oriented 2-manifold mesh
+ * \param[in,out] incidences the edge incidences of \a triangles, kept up to date
+ * \param[in] seeds the vertices the cycles are searched from (where the walk may
+ *            have joined two bodies: round the holes the hole filling closed)
+ * \param[in] min_tunnel_samples cycles of fewer edges than this are cut
+ * \return the number of necks cut
+ */
+std::size_t
+cutShortNecks(const std::vector<Eigen::Vector3d>& points,
+              std::vector<Triangle>& triangles,
+              EdgeIncidences& incidences,
+              const std::vector<int>& seeds,
+              std::size_t min_tunnel_samples = MIN_TUNNEL_SAMPLES);
+
 } // namespace cocone
 } // namespace pcl

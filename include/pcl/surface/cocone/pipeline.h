@@ -122,6 +122,7 @@ struct ReconstructionCounts {
   std::size_t holes_filled = 0;   ///< undersampled holes closed
   std::size_t hole_triangles = 0; ///< triangles added to close them
   std::size_t handles_cut = 0;    ///< handles no sampled tunnel explains, cut
+  std::size_t necks_cut = 0;      ///< necks no sample resolves, cut
 };
 
 /** \brief Wall-clock time of each stage, in milliseconds. */
