@@ -96,6 +96,13 @@ struct VertexEdges {
   }
 };
 
+/** The other end of edge \a e from its end \a x. */
+inline int
+otherEnd(const EdgeIncidences& inc, std::uint32_t e, int x)
+{
+  return inc.edges[e][0] == x ? inc.edges[e][1] : inc.edges[e][0];
+}
+
 /** Per edge, the Z2 cohomology class of the mesh with each border loop capped by a
  * disk, hashed to 64 bits: summed over a cycle's edges it is zero where the cycle
  * separates the surface, and, but with odds of 2^-64, not zero where it does not.
@@ -144,7 +151,7 @@ cohomologyHashes(const EdgeIncidences& inc,
     for (std::size_t q = 0; q < queue.size(); ++q)
       for (std::size_t i = at.first[queue[q]]; i < at.first[queue[q] + 1]; ++i) {
         const std::uint32_t e = at.edge[i];
-        const int w = inc.edges[e][0] == queue[q] ? inc.edges[e][1] : inc.edges[e][0];
+        const int w = otherEnd(inc, e, queue[q]);
         if (component[w] < 0) {
           component[w] = components;
           in_tree[e] = 1;
@@ -235,6 +242,94 @@ struct Cycle {
   }
 };
 
+/** A breadth-first ball of mesh edges round a root: per node its vertex, depth,
+ * tree parent, first hop from the root (its branch), and the hash sum and length of
+ * its tree path. Two paths of different branches and an edge between their ends
+ * make a cycle through the root. */
+class EdgeBall {
+public:
+  struct Node {
+    int vertex, depth, parent, branch;
+    std::uint64_t hash;
+    double length;
+  };
+
+  explicit EdgeBall(std::size_t num_vertices) : slot_(num_vertices, -1) {}
+
+  /** The ball of \a root up to \a depth_limit edges through the vertices \a admit
+   * lets in, with the edges' \a hash (none if empty); the previous ball cleared. */
+  template <typename Admit>
+  void
+  grow(int root,
+       int depth_limit,
+       const std::vector<Eigen::Vector3d>& points,
+       const EdgeIncidences& inc,
+       const VertexEdges& at,
+       const std::vector<std::uint64_t>& hash,
+       const Admit& admit)
+  {
+    for (const Node& n : nodes_)
+      slot_[n.vertex] = -1;
+    nodes_.assign(1, {root, 0, -1, -1, 0, 0.0});
+    slot_[root] = 0;
+    for (std::size_t q = 0; q < nodes_.size(); ++q) {
+      if (nodes_[q].depth == depth_limit)
+        continue;
+      const int x = nodes_[q].vertex;
+      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+        const std::uint32_t e = at.edge[i];
+        const int w = otherEnd(inc, e, x);
+        if (slot_[w] >= 0 || !admit(w))
+          continue;
+        slot_[w] = static_cast<int>(nodes_.size());
+        nodes_.push_back({w,
+                          nodes_[q].depth + 1,
+                          static_cast<int>(q),
+                          q == 0 ? w : nodes_[q].branch,
+                          nodes_[q].hash ^ (hash.empty() ? 0 : hash[e]),
+                          nodes_[q].length + (points[w] - points[x]).norm()});
+      }
+    }
+  }
+
+  const std::vector<Node>&
+  nodes() const
+  {
+    return nodes_;
+  }
+
+  /** The node of vertex \a v, -1 outside the ball. */
+  int
+  slot(int v) const
+  {
+    return slot_[v];
+  }
+
+  /** The cycle of the tree paths to nodes \a a and \a b and the edge between their
+   * ends, \a length long, its vertices from the lowest on (Cycle). */
+  Cycle
+  cycle(int a, int b, double length) const
+  {
+    Cycle c;
+    c.length = length;
+    auto& v = c.vertices;
+    for (int n = b; n > 0; n = nodes_[n].parent)
+      v.push_back(nodes_[n].vertex);
+    v.push_back(nodes_[0].vertex);
+    std::reverse(v.begin(), v.end());
+    for (int n = a; n > 0; n = nodes_[n].parent)
+      v.push_back(nodes_[n].vertex);
+    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
+    if (v[1] > v.back())
+      std::reverse(v.begin() + 1, v.end());
+    return c;
+  }
+
+private:
+  std::vector<int> slot_;
+  std::vector<Node> nodes_;
+};
+
 /** Per vertex, the shortest cycle through it of at most \a max_edges edges whose
  * hash sum is not zero: two paths of a breadth-first tree from the vertex, leaving
  * it by different edges, and an edge between their ends. The shortest
@@ -269,54 +364,30 @@ shortCycles(const std::vector<Eigen::Vector3d>& points,
   std::vector<std::vector<Cycle>> found(parts);
   detail::forEachRange(
       num_vertices, parts, [&](std::size_t begin, std::size_t end, int part) {
-        // Per ball vertex: its slot, depth, tree parent, first hop, hash and length.
-        struct Node {
-          int vertex, depth, parent, branch;
-          std::uint64_t hash;
-          double length;
-        };
-        std::vector<int> slot(num_vertices, -1);
-        std::vector<Node> ball;
+        EdgeBall ball(num_vertices);
+        const auto admit = [&](int w) { return in_handled[w] != 0; };
         for (std::size_t s = begin; s < end; ++s) {
           if (!seed[s] || !in_handled[s])
             continue;
-          ball.assign(1, {static_cast<int>(s), 0, -1, -1, 0, 0.0});
-          slot[s] = 0;
-          for (std::size_t q = 0; q < ball.size(); ++q) {
-            if (ball[q].depth == depth_limit)
-              continue;
-            const int x = ball[q].vertex;
-            for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-              const std::uint32_t e = at.edge[i];
-              const int w = inc.edges[e][0] == x ? inc.edges[e][1] : inc.edges[e][0];
-              if (slot[w] >= 0 || !in_handled[w])
-                continue;
-              slot[w] = static_cast<int>(ball.size());
-              ball.push_back({w,
-                              ball[q].depth + 1,
-                              static_cast<int>(q),
-                              q == 0 ? w : ball[q].branch,
-                              ball[q].hash ^ hash[e],
-                              ball[q].length + (points[w] - points[x]).norm()});
-            }
-          }
+          ball.grow(static_cast<int>(s), depth_limit, points, inc, at, hash, admit);
+          const auto& nodes = ball.nodes();
           std::size_t best_edges = max_edges + 1;
           double best_length = 0.0;
           std::array<int, 2> best_ends{-1, -1};
-          for (std::size_t a = 0; a < ball.size(); ++a) {
-            const int x = ball[a].vertex;
+          for (std::size_t a = 0; a < nodes.size(); ++a) {
+            const int x = nodes[a].vertex;
             for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
               const std::uint32_t e = at.edge[i];
-              const int w = inc.edges[e][0] == x ? inc.edges[e][1] : inc.edges[e][0];
-              const int b = slot[w];
-              if (b <= static_cast<int>(a) || ball[a].branch == ball[b].branch ||
-                  ball[b].parent == static_cast<int>(a) ||
-                  (ball[a].hash ^ ball[b].hash ^ hash[e]) == 0)
+              const int w = otherEnd(inc, e, x);
+              const int b = ball.slot(w);
+              if (b <= static_cast<int>(a) || nodes[a].branch == nodes[b].branch ||
+                  nodes[b].parent == static_cast<int>(a) ||
+                  (nodes[a].hash ^ nodes[b].hash ^ hash[e]) == 0)
                 continue;
-              const std::size_t edges = static_cast<std::size_t>(ball[a].depth) +
-                                        static_cast<std::size_t>(ball[b].depth) + 1;
+              const std::size_t edges = static_cast<std::size_t>(nodes[a].depth) +
+                                        static_cast<std::size_t>(nodes[b].depth) + 1;
               const double length =
-                  ball[a].length + ball[b].length + (points[w] - points[x]).norm();
+                  nodes[a].length + nodes[b].length + (points[w] - points[x]).norm();
               if (edges < best_edges || (edges == best_edges && length < best_length)) {
                 best_edges = edges;
                 best_length = length;
@@ -324,24 +395,8 @@ shortCycles(const std::vector<Eigen::Vector3d>& points,
               }
             }
           }
-          if (best_ends[0] >= 0) {
-            // The root, down the second path, back up the first.
-            Cycle cycle;
-            cycle.length = best_length;
-            auto& v = cycle.vertices;
-            for (int n = best_ends[1]; n > 0; n = ball[n].parent)
-              v.push_back(ball[n].vertex);
-            v.push_back(static_cast<int>(s));
-            std::reverse(v.begin(), v.end());
-            for (int n = best_ends[0]; n > 0; n = ball[n].parent)
-              v.push_back(ball[n].vertex);
-            std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
-            if (v[1] > v.back())
-              std::reverse(v.begin() + 1, v.end());
-            found[part].push_back(std::move(cycle));
-          }
-          for (const Node& n : ball)
-            slot[n.vertex] = -1;
+          if (best_ends[0] >= 0)
+            found[part].push_back(ball.cycle(best_ends[0], best_ends[1], best_length));
         }
       });
   std::vector<Cycle> cycles;
@@ -357,6 +412,19 @@ shortCycles(const std::vector<Eigen::Vector3d>& points,
   return cycles;
 }
 
+/** Whether ab (either way) is an edge of \a cycle. */
+bool
+isCycleEdge(const std::vector<int>& cycle, int a, int b)
+{
+  const std::size_t k = cycle.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    const int c = cycle[i], d = cycle[(i + 1) % k];
+    if ((a == c && b == d) || (a == d && b == c))
+      return true;
+  }
+  return false;
+}
+
 /** How far round \a cycle its two sides meet: a breadth-first search from the
  * triangle on each side of its first edge, across every edge but the cycle's, in
  * turns, until the two meet; the triangles on the shortest way found from one side
@@ -370,15 +438,7 @@ waySidesMeet(const detail::LocalMesh& mesh,
              int max_depth,
              std::vector<int>& depth)
 {
-  const std::size_t k = cycle.size();
-  const auto on_cycle = [&](int a, int b) {
-    for (std::size_t i = 0; i < k; ++i) {
-      const int c = cycle[i], d = cycle[(i + 1) % k];
-      if ((a == c && b == d) || (a == d && b == c))
-        return true;
-    }
-    return false;
-  };
+  const auto on_cycle = [&](int a, int b) { return isCycleEdge(cycle, a, b); };
   // depth: 0 unreached, +d on the left at d - 1 triangles off, -d on the right.
   depth.resize(mesh.triangles().size(), 0);
   std::array<std::vector<int>, 2> queue{
@@ -543,6 +603,38 @@ cutAlong(const std::vector<Eigen::Vector3d>& points,
   return true;
 }
 
+/** Cut along each of \a cycles (shortest first) that \a accept(mesh, cycle) takes
+ * and no earlier cut touched (cutAlong(), either way round), \a incidences brought
+ * up to date; returns the number cut. */
+template <typename Accept>
+std::size_t
+cutCycles(const std::vector<Eigen::Vector3d>& points,
+          std::vector<Triangle>& triangles,
+          EdgeIncidences& incidences,
+          const std::vector<Cycle>& cycles,
+          std::vector<std::uint8_t>& touched,
+          const Accept& accept)
+{
+  const std::size_t before = triangles.size();
+  detail::LocalMesh mesh(triangles, points.size());
+  detail::LeastPerimeterScratch scratch;
+  std::size_t cut = 0;
+  for (const Cycle& cycle : cycles) {
+    if (std::any_of(cycle.vertices.begin(),
+                    cycle.vertices.end(),
+                    [&](int v) { return touched[v] != 0; }) ||
+        !accept(mesh, cycle))
+      continue;
+    const std::vector<int> reversed(cycle.vertices.rbegin(), cycle.vertices.rend());
+    if (cutAlong(points, mesh, cycle.vertices, touched, scratch) ||
+        cutAlong(points, mesh, reversed, touched, scratch))
+      ++cut;
+  }
+  if (cut > 0)
+    mesh.commit(before, incidences);
+  return cut;
+}
+
 /** One round of cutShortHandles(): the candidates on the mesh as it is, each cut
  * unless an earlier cut of the round touched it. */
 std::size_t
@@ -583,26 +675,16 @@ cutRound(const std::vector<Eigen::Vector3d>& points,
       points, incidences, at, hash, in_handled, min_tunnel_samples - 1, threads);
   if (cycles.empty())
     return 0;
-  const std::size_t before = triangles.size();
-  detail::LocalMesh mesh(triangles, num_vertices);
-  detail::LeastPerimeterScratch scratch;
   std::vector<int> depth;
-  std::size_t cut = 0;
-  for (const Cycle& cycle : cycles) {
-    if (std::any_of(cycle.vertices.begin(), cycle.vertices.end(), [&](int v) {
-          return touched[v] != 0;
-        }))
-      continue;
-    if (waySidesMeet(mesh, cycle.vertices, MAX_HANDLE_DEPTH, depth) < 0)
-      continue;
-    const std::vector<int> reversed(cycle.vertices.rbegin(), cycle.vertices.rend());
-    if (cutAlong(points, mesh, cycle.vertices, touched, scratch) ||
-        cutAlong(points, mesh, reversed, touched, scratch))
-      ++cut;
-  }
-  if (cut > 0)
-    mesh.commit(before, incidences);
-  return cut;
+  return cutCycles(points,
+                   triangles,
+                   incidences,
+                   cycles,
+                   touched,
+                   [&](const auto& mesh, const Cycle& c) {
+                     return waySidesMeet(mesh, c.vertices, MAX_HANDLE_DEPTH, depth) >=
+                            0;
+                   });
 }
 
 /** Per side of \a cycle (0: its left, 1: its right), the triangles in each of the
@@ -618,14 +700,7 @@ sideRings(const detail::LocalMesh& mesh,
           std::vector<int>& depth)
 {
   const std::size_t k = cycle.size();
-  const auto on_cycle = [&](int a, int b) {
-    for (std::size_t i = 0; i < k; ++i) {
-      const int c = cycle[i], d = cycle[(i + 1) % k];
-      if ((a == c && b == d) || (a == d && b == c))
-        return true;
-    }
-    return false;
-  };
+  const auto on_cycle = [&](int a, int b) { return isCycleEdge(cycle, a, b); };
   // depth: 0 unreached, +d on the left in ring d, -d on the right.
   depth.resize(mesh.triangles().size(), 0);
   std::array<std::vector<int>, 2> reached, count;
@@ -742,86 +817,47 @@ cutShortNecks(const std::vector<Eigen::Vector3d>& points,
   // Every cycle of two breadth-first paths from a seed and an edge, of 3 to
   // max_edges edges.
   std::vector<Cycle> cycles;
-  {
-    struct Node {
-      int vertex, depth, parent, branch;
-      double length;
-    };
-    std::vector<int> slot(num_vertices, -1);
-    std::vector<Node> ball;
-    for (const int s : seeds) {
-      if (touched[s])
-        continue;
-      ball.assign(1, {s, 0, -1, -1, 0.0});
-      slot[s] = 0;
-      for (std::size_t q = 0; q < ball.size(); ++q) {
-        if (ball[q].depth == depth_limit)
+  EdgeBall ball(num_vertices);
+  const auto admit = [&](int w) { return touched[w] == 0; };
+  for (const int s : seeds) {
+    if (touched[s])
+      continue;
+    ball.grow(s, depth_limit, points, incidences, at, {}, admit);
+    const auto& nodes = ball.nodes();
+    // The ball's triangles (those of its vertices) make a disk round a vertex of a
+    // surface, Euler characteristic 1, where every cycle in it bounds; round a neck
+    // they make an annulus (0).
+    long euler = static_cast<long>(nodes.size());
+    for (std::size_t a = 0; a < nodes.size(); ++a) {
+      const int x = nodes[a].vertex;
+      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+        const std::uint32_t e = at.edge[i];
+        const int w = otherEnd(incidences, e, x);
+        if (ball.slot(w) <= static_cast<int>(a))
           continue;
-        const int x = ball[q].vertex;
-        for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-          const std::uint32_t e = at.edge[i];
-          const int w = incidences.edges[e][0] == x ? incidences.edges[e][1]
-                                                    : incidences.edges[e][0];
-          if (slot[w] >= 0 || touched[w])
-            continue;
-          slot[w] = static_cast<int>(ball.size());
-          ball.push_back({w,
-                          ball[q].depth + 1,
-                          static_cast<int>(q),
-                          q == 0 ? w : ball[q].branch,
-                          ball[q].length + (points[w] - points[x]).norm()});
-        }
+        --euler;
+        for (std::size_t j = incidences.first[e]; j < incidences.first[e + 1]; ++j)
+          for (const int c : triangles[incidences.triangle[j]])
+            if (c != x && c != w && ball.slot(c) > ball.slot(w))
+              ++euler; // counted at the edge of its two lower corners
       }
-      // The ball's triangles (those of its vertices) make a disk round a vertex of
-      // a surface, Euler characteristic 1, where every cycle in it bounds; round a
-      // neck they make an annulus (0).
-      long euler = static_cast<long>(ball.size());
-      for (std::size_t a = 0; a < ball.size(); ++a) {
-        const int x = ball[a].vertex;
-        for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-          const std::uint32_t e = at.edge[i];
-          const int w = incidences.edges[e][0] == x ? incidences.edges[e][1]
-                                                    : incidences.edges[e][0];
-          if (slot[w] <= static_cast<int>(a))
-            continue;
-          --euler;
-          for (std::size_t j = incidences.first[e]; j < incidences.first[e + 1]; ++j)
-            for (const int c : triangles[incidences.triangle[j]])
-              if (c != x && c != w && slot[c] > slot[w])
-                ++euler; // counted at the edge of its two lower corners
-        }
+    }
+    for (std::size_t a = 1; a < nodes.size() && euler < 1; ++a) {
+      const int x = nodes[a].vertex;
+      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+        const std::uint32_t e = at.edge[i];
+        const int w = otherEnd(incidences, e, x);
+        const int b = ball.slot(w);
+        if (b <= static_cast<int>(a) || nodes[a].branch == nodes[b].branch ||
+            static_cast<std::size_t>(nodes[a].depth) +
+                    static_cast<std::size_t>(nodes[b].depth) + 1 >
+                max_edges)
+          continue;
+        cycles.push_back(ball.cycle(static_cast<int>(a),
+                                    b,
+                                    nodes[a].length + nodes[b].length +
+                                        (points[w] - points[x]).norm()));
       }
-      for (std::size_t a = 1; a < ball.size() && euler < 1; ++a) {
-        const int x = ball[a].vertex;
-        for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-          const std::uint32_t e = at.edge[i];
-          const int w = incidences.edges[e][0] == x ? incidences.edges[e][1]
-                                                    : incidences.edges[e][0];
-          const int b = slot[w];
-          if (b <= static_cast<int>(a) || ball[a].branch == ball[b].branch)
-            continue;
-          const std::size_t edges = static_cast<std::size_t>(ball[a].depth) +
-                                    static_cast<std::size_t>(ball[b].depth) + 1;
-          if (edges > max_edges)
-            continue;
-          Cycle cycle;
-          cycle.length =
-              ball[a].length + ball[b].length + (points[w] - points[x]).norm();
-          auto& v = cycle.vertices;
-          for (int n = b; n > 0; n = ball[n].parent)
-            v.push_back(ball[n].vertex);
-          v.push_back(s);
-          std::reverse(v.begin(), v.end());
-          for (int n = static_cast<int>(a); n > 0; n = ball[n].parent)
-            v.push_back(ball[n].vertex);
-          std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
-          if (v[1] > v.back())
-            std::reverse(v.begin() + 1, v.end());
-          cycles.push_back(std::move(cycle));
-        }
-      }
-      for (const Node& n : ball)
-        slot[n.vertex] = -1;
     }
   }
   std::sort(cycles.begin(), cycles.end());
@@ -850,37 +886,31 @@ cutShortNecks(const std::vector<Eigen::Vector3d>& points,
     }
     return sum == 0;
   };
-  const std::size_t before = triangles.size();
-  detail::LocalMesh mesh(triangles, num_vertices);
-  detail::LeastPerimeterScratch scratch;
   std::vector<int> depth;
-  std::size_t cut = 0;
-  for (const Cycle& cycle : cycles) {
-    if (std::any_of(cycle.vertices.begin(), cycle.vertices.end(), [&](int v) {
-          return touched[v] != 0;
-        }))
-      continue;
-    if (!separates(cycle.vertices))
-      continue;
-    // The surface opens out on both sides and grows on as a surface, then goes on
-    // as a body of its own on each.
-    const auto rings = sideRings(mesh, cycle.vertices, 2 * NECK_RINGS, depth);
-    if (rings[0].empty() || std::any_of(rings.begin(), rings.end(), [](const auto& r) {
-          return r[NECK_RINGS - 1] < NECK_OPENING * r[0] ||
-                 r[2 * NECK_RINGS - 1] < NECK_GROWTH * r[NECK_RINGS - 1];
-        }))
-      continue;
-    if (sideRings(mesh, cycle.vertices, NECK_SIDE_RINGS, depth)[0].empty())
-      continue;
-    const std::vector<int> reversed(cycle.vertices.rbegin(), cycle.vertices.rend());
-    if (cutAlong(points, mesh, cycle.vertices, touched, scratch) ||
-        cutAlong(points, mesh, reversed, touched, scratch))
-      ++cut;
-  }
-  if (cut > 0) {
-    mesh.commit(before, incidences);
+  const std::size_t cut = cutCycles(
+      points,
+      triangles,
+      incidences,
+      cycles,
+      touched,
+      [&](const auto& mesh, const Cycle& c) {
+        if (!separates(c.vertices))
+          return false;
+        // The surface opens out on both sides and grows on as a surface, then goes
+        // on as a body of its own on each.
+        const auto rings = sideRings(mesh, c.vertices, 2 * NECK_RINGS, depth);
+        return !rings[0].empty() &&
+               std::none_of(rings.begin(),
+                            rings.end(),
+                            [](const auto& r) {
+                              return r[NECK_RINGS - 1] < NECK_OPENING * r[0] ||
+                                     r[2 * NECK_RINGS - 1] <
+                                         NECK_GROWTH * r[NECK_RINGS - 1];
+                            }) &&
+               !sideRings(mesh, c.vertices, NECK_SIDE_RINGS, depth)[0].empty();
+      });
+  if (cut > 0)
     turnOutward(points, triangles, incidences, touched);
-  }
   return cut;
 }
 
