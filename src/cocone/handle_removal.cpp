@@ -242,6 +242,20 @@ struct Cycle {
   }
 };
 
+/** Sort \a cycles shortest first (fewest edges, then length) and keep each once
+ * (the same cycle is found from each of its vertices). */
+void
+sortOnce(std::vector<Cycle>& cycles)
+{
+  std::sort(cycles.begin(), cycles.end());
+  cycles.erase(std::unique(cycles.begin(),
+                           cycles.end(),
+                           [](const Cycle& a, const Cycle& b) {
+                             return a.vertices == b.vertices;
+                           }),
+               cycles.end());
+}
+
 /** A breadth-first ball of mesh edges round a root: per node its vertex, depth,
  * tree parent, first hop from the root (its branch), and the hash sum and length of
  * its tree path. Two paths of different branches and an edge between their ends
@@ -402,13 +416,7 @@ shortCycles(const std::vector<Eigen::Vector3d>& points,
   std::vector<Cycle> cycles;
   for (auto& f : found)
     std::move(f.begin(), f.end(), std::back_inserter(cycles));
-  std::sort(cycles.begin(), cycles.end());
-  cycles.erase(std::unique(cycles.begin(),
-                           cycles.end(),
-                           [](const Cycle& a, const Cycle& b) {
-                             return a.vertices == b.vertices;
-                           }),
-               cycles.end());
+  sortOnce(cycles);
   return cycles;
 }
 
@@ -766,24 +774,11 @@ turnOutward(const std::vector<Eigen::Vector3d>& points,
   const std::vector<int> component =
       triangleComponents(incidences, triangles.size(), &count);
   std::vector<std::uint8_t> held(count, 0);
-  std::vector<Eigen::Vector3d> centre(count, Eigen::Vector3d::Zero());
-  std::vector<std::size_t> size(count, 0);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const auto& v = triangles[t];
-    const int c = component[t];
-    held[c] |= cut[v[0]] | cut[v[1]] | cut[v[2]];
-    centre[c] += points[v[0]] + points[v[1]] + points[v[2]];
-    ++size[c];
+    held[component[t]] |= cut[v[0]] | cut[v[1]] | cut[v[2]];
   }
-  std::vector<double> volume(count, 0.0);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const auto& v = triangles[t];
-    const int c = component[t];
-    if (held[c]) {
-      const Eigen::Vector3d o = centre[c] / (3.0 * static_cast<double>(size[c]));
-      volume[c] += (points[v[0]] - o).dot((points[v[1]] - o).cross(points[v[2]] - o));
-    }
-  }
+  const std::vector<double> volume = signedVolumes(points, triangles, component, count);
   std::vector<std::uint8_t> turned(triangles.size(), 0);
   for (std::size_t t = 0; t < triangles.size(); ++t)
     if (held[component[t]] && volume[component[t]] < 0.0) {
@@ -860,13 +855,7 @@ cutShortNecks(const std::vector<Eigen::Vector3d>& points,
       }
     }
   }
-  std::sort(cycles.begin(), cycles.end());
-  cycles.erase(std::unique(cycles.begin(),
-                           cycles.end(),
-                           [](const Cycle& a, const Cycle& b) {
-                             return a.vertices == b.vertices;
-                           }),
-               cycles.end());
+  sortOnce(cycles);
   if (cycles.empty())
     return 0;
   const std::vector<std::vector<int>> loops = boundaryLoops(incidences, num_vertices);

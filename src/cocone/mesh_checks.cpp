@@ -5,6 +5,8 @@
 
 #include <pcl/surface/cocone/mesh_checks.h>
 
+#include <Eigen/Geometry>
+
 #include "disjoint_sets.h"
 #include "edge_sort.h"
 
@@ -256,6 +258,34 @@ triangleComponents(const EdgeIncidences& inc,
   if (count)
     *count = static_cast<std::size_t>(n);
   return out;
+}
+
+std::vector<double>
+signedVolumes(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<Triangle>& triangles,
+              const std::vector<int>& component,
+              std::size_t count)
+{
+  // About the centroid rather than the origin: far from the origin the sum would
+  // cancel large terms. Both sums in the order of the triangles (deterministic).
+  std::vector<Eigen::Vector3d> centre(count, Eigen::Vector3d::Zero());
+  std::vector<std::size_t> size(count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& v = triangles[t];
+    centre[component[t]] += points[v[0]] + points[v[1]] + points[v[2]];
+    ++size[component[t]];
+  }
+  for (std::size_t c = 0; c < count; ++c)
+    if (size[c] > 0)
+      centre[c] /= 3.0 * static_cast<double>(size[c]);
+  std::vector<double> volume(count, 0.0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& v = triangles[t];
+    const Eigen::Vector3d& o = centre[component[t]];
+    volume[component[t]] +=
+        (points[v[0]] - o).dot((points[v[1]] - o).cross(points[v[2]] - o));
+  }
+  return volume;
 }
 
 MeshTopology

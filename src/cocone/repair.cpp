@@ -292,33 +292,19 @@ orient(const std::vector<Eigen::Vector3d>& P,
       }
   }
 
-  // Turn each component so that its signed volume about its centroid is positive,
-  // both sums taken in the order of the triangles. The components are numbered in
-  // the order of their roots (in place of the order, no longer needed).
-  std::vector<int>& number = order;
+  // Turn each component so that its signed volume about its centroid is positive.
+  // The components are renumbered in the order of their roots, in place (a root is
+  // its component's lowest triangle, so it is numbered before its members).
   std::size_t components = 0;
-  for (std::size_t t = 0; t < m; ++t)
+  for (std::size_t t = 0; t < m; ++t) {
     if (component[t] == static_cast<int>(t))
-      number[t] = static_cast<int>(components++);
-  std::vector<Eigen::Vector3d> centre(components, Eigen::Vector3d::Zero());
-  std::vector<std::size_t> size(components, 0);
-  for (std::size_t t = 0; t < m; ++t) {
-    const auto& v = triangles[t];
-    const int c = number[component[t]];
-    centre[c] += P[v[0]] + P[v[1]] + P[v[2]];
-    ++size[c];
+      order[t] = static_cast<int>(components++);
+    component[t] = order[component[t]];
   }
-  for (std::size_t c = 0; c < components; ++c)
-    centre[c] /= 3.0 * static_cast<double>(size[c]);
-  std::vector<double> volume(components, 0.0);
-  for (std::size_t t = 0; t < m; ++t) {
-    const auto& v = triangles[t];
-    const Eigen::Vector3d& o = centre[number[component[t]]];
-    volume[number[component[t]]] += (P[v[0]] - o).dot((P[v[1]] - o).cross(P[v[2]] - o));
-  }
+  const std::vector<double> volume = signedVolumes(P, triangles, component, components);
 #pragma omp parallel for num_threads(threads) schedule(static, 8192)
   for (std::ptrdiff_t t = 0; t < num_triangles; ++t)
-    if (volume[number[component[t]]] < 0.0)
+    if (volume[component[t]] < 0.0)
       turn(static_cast<int>(t));
   // The same edges; the turned triangles run them the other way.
   const auto incidences = static_cast<std::ptrdiff_t>(inc.triangle.size());

@@ -137,5 +137,14 @@ triangleComponents(const EdgeIncidences& inc,
                    std::size_t num_triangles,
                    std::size_t* count = nullptr);
 
+/** \brief Per component (\a component numbers each triangle's, 0 to \a count - 1):
+ * the signed volume of its triangles about the centroid of their corners, six times
+ * that of the solid they bound when closed, positive when they face outward. */
+std::vector<double>
+signedVolumes(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<Triangle>& triangles,
+              const std::vector<int>& component,
+              std::size_t count);
+
 } // namespace cocone
 } // namespace pcl
