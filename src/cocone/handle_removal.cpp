@@ -312,6 +312,23 @@ public:
     return nodes_;
   }
 
+  /** Call \a f(a, b, e) for every edge e of the mesh between nodes a < b of the
+   * ball (tree edges too), in the order of a, then of a's edges. */
+  template <typename F>
+  void
+  forEachEdge(const EdgeIncidences& inc, const VertexEdges& at, const F& f) const
+  {
+    for (std::size_t a = 0; a < nodes_.size(); ++a) {
+      const int x = nodes_[a].vertex;
+      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
+        const std::uint32_t e = at.edge[i];
+        const int b = slot_[otherEnd(inc, e, x)];
+        if (b > static_cast<int>(a))
+          f(a, b, e);
+      }
+    }
+  }
+
   /** The node of vertex \a v, -1 outside the ball. */
   int
   slot(int v) const
@@ -388,27 +405,22 @@ shortCycles(const std::vector<Eigen::Vector3d>& points,
           std::size_t best_edges = max_edges + 1;
           double best_length = 0.0;
           std::array<int, 2> best_ends{-1, -1};
-          for (std::size_t a = 0; a < nodes.size(); ++a) {
-            const int x = nodes[a].vertex;
-            for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-              const std::uint32_t e = at.edge[i];
-              const int w = otherEnd(inc, e, x);
-              const int b = ball.slot(w);
-              if (b <= static_cast<int>(a) || nodes[a].branch == nodes[b].branch ||
-                  nodes[b].parent == static_cast<int>(a) ||
-                  (nodes[a].hash ^ nodes[b].hash ^ hash[e]) == 0)
-                continue;
-              const std::size_t edges = static_cast<std::size_t>(nodes[a].depth) +
-                                        static_cast<std::size_t>(nodes[b].depth) + 1;
-              const double length =
-                  nodes[a].length + nodes[b].length + (points[w] - points[x]).norm();
-              if (edges < best_edges || (edges == best_edges && length < best_length)) {
-                best_edges = edges;
-                best_length = length;
-                best_ends = {static_cast<int>(a), b};
-              }
+          ball.forEachEdge(inc, at, [&](std::size_t a, int b, std::uint32_t e) {
+            if (nodes[a].branch == nodes[b].branch ||
+                nodes[b].parent == static_cast<int>(a) ||
+                (nodes[a].hash ^ nodes[b].hash ^ hash[e]) == 0)
+              return;
+            const std::size_t edges = static_cast<std::size_t>(nodes[a].depth) +
+                                      static_cast<std::size_t>(nodes[b].depth) + 1;
+            const double length =
+                nodes[a].length + nodes[b].length +
+                (points[nodes[b].vertex] - points[nodes[a].vertex]).norm();
+            if (edges < best_edges || (edges == best_edges && length < best_length)) {
+              best_edges = edges;
+              best_length = length;
+              best_ends = {static_cast<int>(a), b};
             }
-          }
+          });
           if (best_ends[0] >= 0)
             found[part].push_back(ball.cycle(best_ends[0], best_ends[1], best_length));
         }
@@ -823,37 +835,28 @@ cutShortNecks(const std::vector<Eigen::Vector3d>& points,
     // surface, Euler characteristic 1, where every cycle in it bounds; round a neck
     // they make an annulus (0).
     long euler = static_cast<long>(nodes.size());
-    for (std::size_t a = 0; a < nodes.size(); ++a) {
-      const int x = nodes[a].vertex;
-      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-        const std::uint32_t e = at.edge[i];
-        const int w = otherEnd(incidences, e, x);
-        if (ball.slot(w) <= static_cast<int>(a))
-          continue;
-        --euler;
-        for (std::size_t j = incidences.first[e]; j < incidences.first[e + 1]; ++j)
-          for (const int c : triangles[incidences.triangle[j]])
-            if (c != x && c != w && ball.slot(c) > ball.slot(w))
-              ++euler; // counted at the edge of its two lower corners
-      }
-    }
-    for (std::size_t a = 1; a < nodes.size() && euler < 1; ++a) {
-      const int x = nodes[a].vertex;
-      for (std::size_t i = at.first[x]; i < at.first[x + 1]; ++i) {
-        const std::uint32_t e = at.edge[i];
-        const int w = otherEnd(incidences, e, x);
-        const int b = ball.slot(w);
-        if (b <= static_cast<int>(a) || nodes[a].branch == nodes[b].branch ||
-            static_cast<std::size_t>(nodes[a].depth) +
-                    static_cast<std::size_t>(nodes[b].depth) + 1 >
-                max_edges)
-          continue;
-        cycles.push_back(ball.cycle(static_cast<int>(a),
-                                    b,
-                                    nodes[a].length + nodes[b].length +
-                                        (points[w] - points[x]).norm()));
-      }
-    }
+    ball.forEachEdge(incidences, at, [&](std::size_t, int b, std::uint32_t e) {
+      --euler;
+      for (std::size_t j = incidences.first[e]; j < incidences.first[e + 1]; ++j)
+        for (const int c : triangles[incidences.triangle[j]])
+          if (ball.slot(c) > b)
+            ++euler; // counted at the edge of its two lower corners
+    });
+    if (euler >= 1)
+      continue;
+    ball.forEachEdge(incidences, at, [&](std::size_t a, int b, std::uint32_t) {
+      // The root's edges close no cycle (a path and its first edge).
+      if (a == 0 || nodes[a].branch == nodes[b].branch ||
+          static_cast<std::size_t>(nodes[a].depth) +
+                  static_cast<std::size_t>(nodes[b].depth) + 1 >
+              max_edges)
+        return;
+      cycles.push_back(
+          ball.cycle(static_cast<int>(a),
+                     b,
+                     nodes[a].length + nodes[b].length +
+                         (points[nodes[b].vertex] - points[nodes[a].vertex]).norm()));
+    });
   }
   sortOnce(cycles);
   if (cycles.empty())
