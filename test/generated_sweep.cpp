@@ -1,0 +1,187 @@
+/*
+ * pcl_cocone_boundary: boundary-aware Co-cone surface reconstruction for PCL.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+
+#include <pcl/surface/cocone/mesh_checks.h>
+#include <pcl/surface/cocone/pipeline.h>
+
+#include <support/cases.h>
+#include <support/metrics.h>
+#include <support/surfaces.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+// Sweeps the generated surfaces of the tests over sizes, samplings and seeds and
+// compares each default reconstruction's topology with the truth
+// (build/test/cocone_generated_sweep [--noise S] [--sizes N,N,...] [--seeds K]
+// [--threads T] [--failures]): per case the components, border loops and Euler
+// characteristic found and true, and the samples set aside as outliers (on a clean
+// cloud every one is false); then per surface and in all the cases whose topology
+// is wrong. Where the tests check chosen cases, this shows how often a surface of
+// each kind comes out right.
+using namespace cocone_test;
+
+namespace {
+
+struct Surface {
+  std::string name;
+  std::function<Sample(const SampleOptions&)> make;
+};
+
+/** The samplings swept: even (Poisson-disk), area-uniform random, and even with the
+ * density growing 1:8 along x. */
+struct Sampling {
+  std::string name;
+  bool even;
+  double density_ratio;
+};
+
+struct Tally {
+  std::size_t cases = 0, wrong = 0, extra_loops = 0, false_outliers = 0;
+};
+
+std::vector<std::size_t>
+parseSizes(const std::string& list)
+{
+  std::vector<std::size_t> sizes;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const unsigned long n = std::strtoul(item.c_str(), &end, 10);
+    if (end == item.c_str() || *end != '\0' || n < 100)
+      return {};
+    sizes.push_back(n);
+  }
+  return sizes;
+}
+
+} // namespace
+
+int
+main(int argc, char** argv)
+{
+  double noise = 0.0;
+  std::vector<std::size_t> sizes{3000, 10000};
+  unsigned long seeds = 2;
+  int threads = 1;
+  bool failures_only = false;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    if (arg == "--noise" && a + 1 < argc)
+      noise = std::strtod(argv[++a], nullptr);
+    else if (arg == "--sizes" && a + 1 < argc)
+      sizes = parseSizes(argv[++a]);
+    else if (arg == "--seeds" && a + 1 < argc)
+      seeds = std::strtoul(argv[++a], nullptr, 10);
+    else if (arg == "--threads" && a + 1 < argc)
+      threads = std::atoi(argv[++a]);
+    else if (arg == "--failures")
+      failures_only = true;
+    else
+      sizes.clear();
+  }
+  if (sizes.empty() || seeds < 1 || !(noise >= 0.0) || threads < 0) {
+    std::fprintf(stderr,
+                 "usage: %s [--noise S] [--sizes N,N,...] [--seeds K] [--threads T] "
+                 "[--failures]\n  S: noise sigma in spacings (default 0); N: at least "
+                 "100 points (default 3000,10000); K: seeds 1 to K (default 2)\n",
+                 argv[0]);
+    return 2;
+  }
+
+  const std::vector<Surface> surfaces{
+      {"sphere", [](const SampleOptions& o) { return sphere(o); }},
+      {"ellipsoid", [](const SampleOptions& o) { return ellipsoid(o); }},
+      {"torus", [](const SampleOptions& o) { return torus(o); }},
+      {"genus 2", [](const SampleOptions& o) { return genus2(o); }},
+      {"cube", [](const SampleOptions& o) { return cube(o); }},
+      {"thin plate", [](const SampleOptions& o) { return thinPlate(o); }},
+      {"knotted tube", [](const SampleOptions& o) { return tube(o); }},
+      {"touching spheres",
+       [](const SampleOptions& o) { return twoTouchingSpheres(o); }},
+      {"hemisphere", [](const SampleOptions& o) { return hemisphere(o); }},
+      {"monkey saddle", [](const SampleOptions& o) { return monkeySaddle(o); }},
+      {"open cylinder", [](const SampleOptions& o) { return openCylinder(o); }},
+      {"sphere, 3 holes", [](const SampleOptions& o) { return sphereWithHoles(o); }},
+      {"three components", [](const SampleOptions& o) { return threeComponents(o); }},
+  };
+  const std::vector<Sampling> samplings{
+      {"even", true, 1.0}, {"random", false, 1.0}, {"even 1:8", true, 8.0}};
+
+  pcl::cocone::Parameters parameters;
+  parameters.threads = threads;
+  std::printf("noise sigma %.2f spacings, default parameters\n\n", noise);
+  std::printf("| surface | points | sampling | seed | truth (components, loops, χ) | "
+              "found | outliers | |\n|---|--:|---|--:|---|---|--:|---|\n");
+  std::vector<Tally> tally(surfaces.size());
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    for (const std::size_t n : sizes)
+      for (const Sampling& sampling : samplings)
+        for (unsigned long seed = 1; seed <= seeds; ++seed) {
+          SampleOptions o = options(n, noise, sampling.density_ratio, sampling.even);
+          o.seed = seed;
+          const Sample s = surfaces[k].make(o);
+          const pcl::cocone::Result r = pcl::cocone::run(
+              s.points, parameters, pcl::cocone::Stages::RECONSTRUCTION);
+          const MeshScore m = scoreMesh(s, r);
+          const bool right = r.error.empty() && m.topology.manifold() &&
+                             m.topology.components == std::size_t(s.components) &&
+                             m.loops == std::size_t(s.boundary_loops) &&
+                             m.topology.euler == s.euler;
+          Tally& t = tally[k];
+          ++t.cases;
+          t.wrong += !right;
+          if (m.loops > std::size_t(s.boundary_loops))
+            t.extra_loops += m.loops - std::size_t(s.boundary_loops);
+          // The generated clouds have no outliers: a sample set aside is lost surface.
+          t.false_outliers += r.outlier_indices.size();
+          if (failures_only && right)
+            continue;
+          std::printf(
+              "| %s | %zu | %s | %lu | %d, %d, %d | %zu, %zu, %ld%s | %zu | %s |\n",
+              surfaces[k].name.c_str(),
+              s.points.size(),
+              sampling.name.c_str(),
+              seed,
+              s.components,
+              s.boundary_loops,
+              s.euler,
+              m.topology.components,
+              m.loops,
+              m.topology.euler,
+              m.topology.manifold() ? "" : ", non-manifold",
+              r.outlier_indices.size(),
+              right ? "" : (r.error.empty() ? "wrong" : r.error.c_str()));
+          std::fflush(stdout);
+        }
+
+  std::printf("\n| surface | cases | topology wrong | extra loops | outliers |\n"
+              "|---|--:|--:|--:|--:|\n");
+  Tally all;
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const Tally& t = tally[k];
+    std::printf("| %s | %zu | %zu | %zu | %zu |\n",
+                surfaces[k].name.c_str(),
+                t.cases,
+                t.wrong,
+                t.extra_loops,
+                t.false_outliers);
+    all.cases += t.cases;
+    all.wrong += t.wrong;
+    all.extra_loops += t.extra_loops;
+    all.false_outliers += t.false_outliers;
+  }
+  std::printf("| all | %zu | %zu | %zu | %zu |\n",
+              all.cases,
+              all.wrong,
+              all.extra_loops,
+              all.false_outliers);
+  return 0;
+}
