@@ -20,10 +20,11 @@
 // Sweeps the generated surfaces of the tests over sizes, samplings and seeds and
 // compares each default reconstruction's topology with the truth
 // (build/test/cocone_generated_sweep [--noise S] [--sizes N,N,...] [--seeds K]
-// [--threads T] [--failures]): per case the components, border loops and Euler
-// characteristic found and true, and the samples set aside as outliers (on a clean
-// cloud every one is false); then per surface and in all the cases whose topology
-// is wrong. Where the tests check chosen cases, this shows how often a surface of
+// [--threads T] [--failures] [--write DIR]): per case the components, border loops and
+// Euler characteristic found and true, and the samples set aside as outliers (on a
+// clean cloud every one is false); then per surface and in all the cases whose topology
+// is wrong (--write: the clouds of those cases as DIR/NAME.xyz, to look into). Where
+// the tests check chosen cases, this shows how often a surface of
 // each kind comes out right.
 using namespace cocone_test;
 
@@ -62,6 +63,26 @@ parseSizes(const std::string& list)
   return sizes;
 }
 
+/** Write \a points to DIR/NAME.xyz, NAME's spaces and colons as underscores. */
+void
+writeCloud(const std::string& dir,
+           std::string name,
+           const std::vector<Eigen::Vector3d>& points)
+{
+  for (char& c : name)
+    if (c == ' ' || c == ':')
+      c = '_';
+  const std::string path = dir + "/" + name + ".xyz";
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (!out) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    return;
+  }
+  for (const auto& p : points)
+    std::fprintf(out, "%.17g %.17g %.17g\n", p.x(), p.y(), p.z());
+  std::fclose(out);
+}
+
 } // namespace
 
 int
@@ -72,6 +93,7 @@ main(int argc, char** argv)
   unsigned long seeds = 2;
   int threads = 1;
   bool failures_only = false;
+  std::string write_dir;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--noise" && a + 1 < argc)
@@ -84,13 +106,16 @@ main(int argc, char** argv)
       threads = std::atoi(argv[++a]);
     else if (arg == "--failures")
       failures_only = true;
+    else if (arg == "--write" && a + 1 < argc)
+      write_dir = argv[++a];
     else
       sizes.clear();
   }
   if (sizes.empty() || seeds < 1 || !(noise >= 0.0) || threads < 0) {
     std::fprintf(stderr,
                  "usage: %s [--noise S] [--sizes N,N,...] [--seeds K] [--threads T] "
-                 "[--failures]\n  S: noise sigma in spacings (default 0); N: at least "
+                 "[--failures] [--write DIR]\n  S: noise sigma in spacings (default "
+                 "0); N: at least "
                  "100 points (default 3000,10000); K: seeds 1 to K (default 2)\n",
                  argv[0]);
     return 2;
@@ -144,6 +169,11 @@ main(int argc, char** argv)
           t.false_outliers += r.outlier_indices.size();
           if (failures_only && right)
             continue;
+          if (!right && !write_dir.empty())
+            writeCloud(write_dir,
+                       surfaces[k].name + " " + std::to_string(n) + " " +
+                           sampling.name + " " + std::to_string(seed),
+                       s.points);
           std::printf(
               "| %s | %zu | %s | %lu | %d, %d, %d | %zu, %zu, %ld%s | %zu | %s |\n",
               surfaces[k].name.c_str(),
