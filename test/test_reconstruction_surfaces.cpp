@@ -32,6 +32,7 @@
 #include <ostream>
 #include <random>
 #include <set>
+#include <tuple>
 
 using cocone_test::options;
 using cocone_test::paper;
@@ -1919,6 +1920,77 @@ TEST(HoleFilling, TouchingSpheresComeOutApart)
                   .counts.necks_cut,
               0u);
   }
+}
+
+TEST(HoleFilling, LayersWithinASpacingOfALargerPieceGo)
+{
+  // A sphere's mesh and a small closed piece (a flattened octahedron a spacing
+  // across) off its surface: within a spacing of it, the piece is a layer the
+  // sample does not resolve from the sphere and goes; 3 spacings off, or as thick as
+  // the spacing with its far side 2.7 spacings off, it is a body of its own and stays.
+  const auto s = cocone_test::sphere(cocone_test::options(3000));
+  const auto r = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  ASSERT_TRUE(cocone_test::closedSurface(cocone_test::scoreMesh(s, r), 1, 2));
+  const double h = s.spacing;
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, 2.0, 2.0) / 3.0;
+  const Eigen::Vector3d t1 = n.cross(Eigen::Vector3d::UnitZ()).normalized(),
+                        t2 = n.cross(t1);
+  const auto with_piece =
+      [&](double offset, double half_thickness, std::vector<Eigen::Vector3d>& points) {
+        points = s.points;
+        std::vector<pcl::cocone::Triangle> triangles = r.polygons;
+        const int o = static_cast<int>(points.size());
+        const Eigen::Vector3d c = (1.0 + offset * h) * n;
+        for (const Eigen::Vector3d& d : {Eigen::Vector3d(0.5 * h * t1),
+                                         Eigen::Vector3d(0.5 * h * t2),
+                                         Eigen::Vector3d(half_thickness * h * n)}) {
+          points.push_back(c + d);
+          points.push_back(c - d);
+        }
+        // Vertices o + 2k and o + 2k + 1 on axis k (t1, t2, n: right-handed), + then -:
+        // the eight faces, outward (turned where an odd number of their corners is -).
+        for (const int a : {0, 1})
+          for (const int b : {2, 3})
+            for (const int z : {4, 5}) {
+              const bool odd = (a + b + z) % 2 == 1;
+              triangles.push_back(odd ? pcl::cocone::Triangle{o + a, o + z, o + b}
+                                      : pcl::cocone::Triangle{o + a, o + b, o + z});
+            }
+        return triangles;
+      };
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& [offset, half_thickness, dropped] :
+       {std::tuple<double, double, bool>{0.3, 0.1, true},
+        std::tuple<double, double, bool>{3.0, 0.1, false},
+        std::tuple<double, double, bool>{1.5, 1.2, false}}) {
+    auto triangles = with_piece(offset, half_thickness, points);
+    const auto topology = pcl::cocone::analyzeMesh(triangles, points.size());
+    ASSERT_TRUE(topology.manifold());
+    ASSERT_EQ(topology.closed_components, 2u);
+    const std::vector<double> spacing(points.size(), h);
+    EXPECT_EQ(pcl::cocone::dropLayers(points, spacing, triangles), dropped ? 8u : 0u)
+        << "offset " << offset << " half thickness " << half_thickness;
+    EXPECT_EQ(triangles.size(), r.polygons.size() + (dropped ? 0u : 8u));
+  }
+  // The sphere alone keeps everything.
+  auto alone = r.polygons;
+  EXPECT_EQ(
+      pcl::cocone::dropLayers(s.points, std::vector<double>(s.points.size(), h), alone),
+      0u);
+
+  // Touching spheres half a spacing apart, 10,000 random samples: the patches
+  // closed 4 flat pieces of 8 to 44 samples of the two caps between the spheres
+  // (6 components, Euler 12), each within a spacing of the spheres' triangles.
+  auto o = cocone_test::options(10000, 0.0, 1.0, false);
+  o.seed = 2;
+  const auto touching = cocone_test::twoTouchingSpheres(o);
+  const auto t = pcl::cocone::run(
+      touching.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const auto m = cocone_test::scoreMesh(touching, t);
+  std::printf("[ measured ] touching spheres, 10000 random samples, seed 2: %s\n",
+              m.str().c_str());
+  EXPECT_TRUE(cocone_test::closedSurface(m, 2, 4));
 }
 
 TEST(HoleFilling, NearlyTouchingSpheres)

@@ -6,6 +6,8 @@
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/repair.h>
 
+#include <CGAL/Simple_cartesian.h>
+
 #include <Eigen/Geometry>
 
 #include "least_perimeter.h"
@@ -15,6 +17,7 @@
 #include <limits>
 #include <queue>
 #include <tuple>
+#include <unordered_map>
 
 namespace pcl {
 namespace cocone {
@@ -522,6 +525,117 @@ dropSpecks(std::vector<Triangle>& triangles,
         for (std::size_t c = 0; c < count; ++c)
           speck[c] = vertices[c] < min_vertices;
         return speck;
+      });
+}
+
+std::size_t
+dropLayers(const std::vector<Eigen::Vector3d>& points,
+           const std::vector<double>& spacing,
+           std::vector<Triangle>& triangles,
+           EdgeIncidences* incidences)
+{
+  return dropComponents(
+      triangles,
+      incidences,
+      [&](const EdgeIncidences&, const std::vector<int>& component, std::size_t count) {
+        std::vector<std::uint8_t> layer(count, 0);
+        if (count < 2)
+          return layer;
+        // Per vertex its component (one: a vertex has one fan); vertices per one.
+        std::vector<int> piece(points.size(), -1);
+        std::vector<std::size_t> vertices(count, 0);
+        for (std::size_t t = 0; t < triangles.size(); ++t)
+          for (const int v : triangles[t])
+            if (piece[v] < 0) {
+              piece[v] = component[t];
+              ++vertices[component[t]];
+            }
+        const std::size_t largest = *std::max_element(vertices.begin(), vertices.end());
+        // The vertices of the smaller pieces, within a box and a reach (the grid's
+        // cell) that their spacings give.
+        Eigen::AlignedBox3d box;
+        double cell = 0.0;
+        for (std::size_t v = 0; v < points.size(); ++v)
+          if (piece[v] >= 0 && vertices[piece[v]] < largest) {
+            box.extend(points[v]);
+            cell = std::max(cell, spacing[v]);
+          }
+        if (box.isEmpty() || !(cell > 0.0) || !std::isfinite(cell))
+          return layer;
+        box.min().array() -= cell;
+        box.max().array() += cell;
+        // The triangles that meet the box, in a hash grid of that cell (a key
+        // packs the cell's three coordinates, 21 bits each, from the box's corner).
+        const auto coordinate = [&](double x, int axis) {
+          return static_cast<std::uint64_t>(
+              std::clamp((x - box.min()[axis]) / cell, 0.0, double((1 << 21) - 1)));
+        };
+        const auto key = [](std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+          return x | (y << 21) | (z << 42);
+        };
+        std::unordered_map<std::uint64_t, std::vector<int>> grid;
+        for (std::size_t t = 0; t < triangles.size(); ++t) {
+          Eigen::AlignedBox3d tbox;
+          for (const int v : triangles[t])
+            tbox.extend(points[v]);
+          if (!tbox.intersects(box))
+            continue;
+          tbox = tbox.intersection(box);
+          for (auto x = coordinate(tbox.min()[0], 0); x <= coordinate(tbox.max()[0], 0);
+               ++x)
+            for (auto y = coordinate(tbox.min()[1], 1);
+                 y <= coordinate(tbox.max()[1], 1);
+                 ++y)
+              for (auto z = coordinate(tbox.min()[2], 2);
+                   z <= coordinate(tbox.max()[2], 2);
+                   ++z)
+                grid[key(x, y, z)].push_back(static_cast<int>(t));
+        }
+        // A smaller piece is a layer if each of its vertices has a triangle of a
+        // larger piece within its spacing (the cells round it hold them all).
+        using Kernel = CGAL::Simple_cartesian<double>;
+        const auto point = [&](int v) {
+          return Kernel::Point_3(points[v][0], points[v][1], points[v][2]);
+        };
+        for (std::size_t c = 0; c < count; ++c)
+          layer[c] = vertices[c] < largest;
+        for (std::size_t v = 0; v < points.size(); ++v) {
+          const int c = piece[v];
+          if (c < 0 || !layer[c])
+            continue;
+          const double reach2 = spacing[v] * spacing[v];
+          bool within = false;
+          const auto around = [&](int axis, std::int64_t step) {
+            return static_cast<std::int64_t>(coordinate(points[v][axis], axis)) + step;
+          };
+          for (std::int64_t dx = -1; dx <= 1 && !within; ++dx)
+            for (std::int64_t dy = -1; dy <= 1 && !within; ++dy)
+              for (std::int64_t dz = -1; dz <= 1 && !within; ++dz) {
+                const std::int64_t x = around(0, dx), y = around(1, dy),
+                                   z = around(2, dz);
+                if (x < 0 || y < 0 || z < 0)
+                  continue;
+                const auto found = grid.find(key(static_cast<std::uint64_t>(x),
+                                                 static_cast<std::uint64_t>(y),
+                                                 static_cast<std::uint64_t>(z)));
+                if (found == grid.end())
+                  continue;
+                for (const int t : found->second) {
+                  const Triangle& tri = triangles[t];
+                  if (vertices[component[t]] <= vertices[c])
+                    continue;
+                  if (CGAL::squared_distance(
+                          point(static_cast<int>(v)),
+                          Kernel::Triangle_3(
+                              point(tri[0]), point(tri[1]), point(tri[2]))) <= reach2) {
+                    within = true;
+                    break;
+                  }
+                }
+              }
+          layer[c] = within;
+        }
+        return layer;
       });
 }
 

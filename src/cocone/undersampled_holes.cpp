@@ -429,11 +429,11 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     fill_from(advancingFrontMesh(points, islands(region), threads),
               BAND_PER_LOOP_EDGE,
               false);
-  // What the walk left between sheets a couple of spacings apart, closed by the
-  // patches or not, is no surface: the specks go, with their loops and holes.
-  counts.repair.speck =
-      dropSpecks(result.triangles, points.size(), MIN_PIECE_VERTICES, &incidences);
-  if (counts.repair.speck > 0) {
+  // Pieces dropped (\a dropped triangles) go with their loops and holes.
+  const auto forget_dropped = [&](std::size_t dropped) {
+    counts.repair.speck += dropped;
+    if (dropped == 0)
+      return;
     result.border_loops = boundaryLoops(incidences, points.size());
     const std::vector<std::uint8_t> used =
         usedVertices(result.triangles, points.size());
@@ -443,7 +443,11 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                        [&](const std::vector<int>& rim) { return !used[rim[0]]; });
     counts.holes_filled -= static_cast<std::size_t>(result.filled_holes.end() - gone);
     result.filled_holes.erase(gone, result.filled_holes.end());
-  }
+  };
+  // What the walk left between sheets a couple of spacings apart, closed by the
+  // patches or not, is no surface: the specks go.
+  forget_dropped(
+      dropSpecks(result.triangles, points.size(), MIN_PIECE_VERTICES, &incidences));
   // Holes round samples no mesh made a surface of, closed through them.
   fill_through_inner_samples();
   // Pieces whose holes no patch closes, closed whole by the advancing front.
@@ -487,6 +491,9 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
     counts.necks_cut =
         cutShortNecks(points, result.triangles, incidences, seeds, MIN_TUNNEL_SAMPLES);
   }
+  // The layers between two surfaces closer than the spacing, which the patches and
+  // cuts have left apart from both.
+  forget_dropped(dropLayers(points, spacing, result.triangles, &incidences));
   // The borders left through the samples on them.
   counts.repair.peeled =
       peelBorderSlivers(points, result.triangles, incidences, result.border_loops);

@@ -32,7 +32,8 @@ struct RepairCounts {
   std::size_t filled = 0;
   /** Dropped with components that have no inner vertex (see dropRibbons()). */
   std::size_t ribbon = 0;
-  /** Dropped with components of too few vertices (see dropSpecks()). */
+  /** Dropped with components of too few vertices (see dropSpecks()) or within a
+   * spacing of a larger one (see dropLayers()). */
   std::size_t speck = 0;
   /** Peeled off true borders (see peelBorderSlivers()). */
   std::size_t peeled = 0;
@@ -131,6 +132,25 @@ std::size_t
 dropSpecks(std::vector<Triangle>& triangles,
            std::size_t num_vertices,
            std::size_t min_vertices,
+           EdgeIncidences* incidences = nullptr);
+
+/** \brief Drop the components of the mesh that lie within the sampling of a larger
+ * one: each of their vertices is within its local spacing (\a spacing) of a
+ * triangle of a component of more vertices.
+ *
+ * Where two bodies come closer than the spacing (touching spheres, two registered
+ * views of a surface a little apart) the walk and the patches can make a layer of
+ * the samples between the two surfaces, a closed flat piece or a patch, apart from
+ * both while each surface closes over it. What lies within a spacing of a surface
+ * the sample does not resolve from it; a body of its own has a side farther off.
+ * Their points stay vertices, in no triangle.
+ * \param[in,out] incidences as for dropSpecks()
+ * \return the number of triangles dropped
+ */
+std::size_t
+dropLayers(const std::vector<Eigen::Vector3d>& points,
+           const std::vector<double>& spacing,
+           std::vector<Triangle>& triangles,
            EdgeIncidences* incidences = nullptr);
 
 /** \brief Take the triangles marked in \a drop out of \a triangles (the others keep
