@@ -476,6 +476,26 @@ dropComponents(std::vector<Triangle>& triangles,
   return removeTriangles(triangles, drop, incidences);
 }
 
+/** Per vertex its component (-1 in no triangle; one at most, as its fan is one) from
+ * the triangles' \a component ids, and in \a vertices the vertices of each. */
+std::vector<int>
+vertexComponents(const std::vector<Triangle>& triangles,
+                 const std::vector<int>& component,
+                 std::size_t count,
+                 std::size_t num_vertices,
+                 std::vector<std::size_t>& vertices)
+{
+  std::vector<int> piece(num_vertices, -1);
+  vertices.assign(count, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int v : triangles[t])
+      if (piece[v] < 0) {
+        piece[v] = component[t];
+        ++vertices[component[t]];
+      }
+  return piece;
+}
+
 } // namespace
 
 std::size_t
@@ -512,15 +532,8 @@ dropSpecks(std::vector<Triangle>& triangles,
       triangles,
       incidences,
       [&](const EdgeIncidences&, const std::vector<int>& component, std::size_t count) {
-        // Vertices per component: a vertex is in one (its fan is one).
-        std::vector<std::uint8_t> counted(num_vertices, 0);
-        std::vector<std::size_t> vertices(count, 0);
-        for (std::size_t t = 0; t < triangles.size(); ++t)
-          for (const int v : triangles[t])
-            if (!counted[v]) {
-              counted[v] = 1;
-              ++vertices[component[t]];
-            }
+        std::vector<std::size_t> vertices;
+        vertexComponents(triangles, component, count, num_vertices, vertices);
         std::vector<std::uint8_t> speck(count, 0);
         for (std::size_t c = 0; c < count; ++c)
           speck[c] = vertices[c] < min_vertices;
@@ -541,15 +554,9 @@ dropLayers(const std::vector<Eigen::Vector3d>& points,
         std::vector<std::uint8_t> layer(count, 0);
         if (count < 2)
           return layer;
-        // Per vertex its component (one: a vertex has one fan); vertices per one.
-        std::vector<int> piece(points.size(), -1);
-        std::vector<std::size_t> vertices(count, 0);
-        for (std::size_t t = 0; t < triangles.size(); ++t)
-          for (const int v : triangles[t])
-            if (piece[v] < 0) {
-              piece[v] = component[t];
-              ++vertices[component[t]];
-            }
+        std::vector<std::size_t> vertices;
+        const std::vector<int> piece =
+            vertexComponents(triangles, component, count, points.size(), vertices);
         const std::size_t largest = *std::max_element(vertices.begin(), vertices.end());
         // The vertices of the smaller pieces, within a box and a reach (the grid's
         // cell) that their spacings give.
