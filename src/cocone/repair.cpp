@@ -541,6 +541,11 @@ dropSpecks(std::vector<Triangle>& triangles,
       });
 }
 
+/** The most grid cells a triangle is listed in by dropLayers(): a triangle of the
+ * mesh spans a few spacings, the cell being the largest spacing of the pieces
+ * tested. */
+constexpr std::uint64_t MAX_CELLS = 64;
+
 std::size_t
 dropLayers(const std::vector<Eigen::Vector3d>& points,
            const std::vector<double>& spacing,
@@ -573,6 +578,8 @@ dropLayers(const std::vector<Eigen::Vector3d>& points,
         box.max().array() += cell;
         // The triangles that meet the box, in a hash grid of that cell (a key
         // packs the cell's three coordinates, 21 bits each, from the box's corner).
+        // A triangle over more cells than MAX_CELLS (one across a wide patch) is
+        // left out: it then keeps a piece rather than drop it.
         const auto coordinate = [&](double x, int axis) {
           return static_cast<std::uint64_t>(
               std::clamp((x - box.min()[axis]) / cell, 0.0, double((1 << 21) - 1)));
@@ -588,6 +595,12 @@ dropLayers(const std::vector<Eigen::Vector3d>& points,
           if (!tbox.intersects(box))
             continue;
           tbox = tbox.intersection(box);
+          std::uint64_t cells = 1;
+          for (int axis = 0; axis < 3; ++axis)
+            cells *= coordinate(tbox.max()[axis], axis) -
+                     coordinate(tbox.min()[axis], axis) + 1;
+          if (cells > MAX_CELLS)
+            continue;
           for (auto x = coordinate(tbox.min()[0], 0); x <= coordinate(tbox.max()[0], 0);
                ++x)
             for (auto y = coordinate(tbox.min()[1], 1);
