@@ -83,6 +83,18 @@ constexpr double REOPENED_SIGMAS = 3.0;
  * shared clouds has hundreds. */
 constexpr std::size_t MIN_PIECE_VERTICES = 8;
 
+/** One ring: mark in \a grown the corners of those \a triangles that have one in
+ * \a region. */
+void
+addRing(const std::vector<Triangle>& triangles,
+        const std::vector<std::uint8_t>& region,
+        std::vector<std::uint8_t>& grown)
+{
+  for (const auto& t : triangles)
+    if (region[t[0]] || region[t[1]] || region[t[2]])
+      grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
+}
+
 } // namespace
 
 void
@@ -161,9 +173,7 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
         if (reach[i] && (region[t[0]] || region[t[1]] || region[t[2]]))
           grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
       }
-      for (const auto& t : result.triangles)
-        if (region[t[0]] || region[t[1]] || region[t[2]])
-          grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
+      addRing(result.triangles, region, grown);
       region = std::move(grown);
     }
     return region;
@@ -325,9 +335,7 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       constexpr int FRONT_RINGS = 2;
       for (int ring = 0; ring < FRONT_RINGS; ++ring) {
         std::vector<std::uint8_t> grown = near;
-        for (const Triangle& t : front)
-          if (near[t[0]] || near[t[1]] || near[t[2]])
-            grown[t[0]] = grown[t[1]] = grown[t[2]] = 1;
+        addRing(front, near, grown);
         near = std::move(grown);
       }
       std::vector<Triangle> local;
@@ -481,9 +489,7 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
       for (const int v : loop)
         rim[v] = 1;
     std::vector<std::uint8_t> near = rim;
-    for (const auto& t : result.triangles)
-      if (rim[t[0]] || rim[t[1]] || rim[t[2]])
-        near[t[0]] = near[t[1]] = near[t[2]] = 1;
+    addRing(result.triangles, rim, near);
     std::vector<int> seeds;
     for (std::size_t v = 0; v < near.size(); ++v)
       if (near[v])
