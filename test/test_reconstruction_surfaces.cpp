@@ -2035,6 +2035,34 @@ TEST(HoleFilling, NearlyTouchingSpheres)
             0u);
 }
 
+TEST(HoleFilling, InnerSamplesOfTheOtherSheetStayOut)
+{
+  // Touching spheres half a spacing apart, 10,000 even samples: each sphere has a
+  // hole where it faces the other, its free samples inside. Over the first hole's
+  // round loop the quadratic height ran between the two caps, and its patch took
+  // the other cap's samples too (60 triangles joined the spheres), leaving the
+  // other hole without them: 1 loop, Euler 3. Each hole takes its own sheet's.
+  auto o = cocone_test::options(10000, 0.0, 1.0, true);
+  o.seed = 1;
+  const auto s = cocone_test::twoTouchingSpheres(o);
+  const auto r = pcl::cocone::run(
+      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
+  const auto m = cocone_test::scoreMesh(s, r);
+  std::printf("[ measured ] touching spheres, 10000 even samples, seed 1: %s\n",
+              m.str().c_str());
+  EXPECT_TRUE(cocone_test::closedSurface(m, 2, 4));
+  EXPECT_GT(r.counts.holes_filled, 1u);
+  // No triangle joins the spheres (centred on the x axis either side of 0).
+  std::size_t joining = 0;
+  for (const auto& t : r.triangles) {
+    int right = 0;
+    for (const int v : t)
+      right += r.positions[v].x() + r.offset.x() > 0.0;
+    joining += right % 3 != 0;
+  }
+  EXPECT_EQ(joining, 0u);
+}
+
 TEST(HoleFilling, CoarseTubeComesOutClosed)
 {
   // A knotted tube with about 6, 7 and 8 samples around its circumference (5,000,

@@ -26,7 +26,9 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <numeric>
+#include <queue>
 #include <set>
 #include <utility>
 
@@ -888,6 +890,143 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
   return out;
 }
 
+namespace {
+
+/** A sample of the hole's sheet lies within this share of the spacing of the plane
+ * the samples taken within a spacing of it span (less the noise): without noise a
+ * surface leaves its tangent plane by about a tenth of a spacing over one. Two
+ * sheets closer than the window of fillHolesWithInnerSamples() (two bodies
+ * touching, half a spacing apart) stand over each other: a sample of the other
+ * sheet is off that plane by their distance. */
+constexpr double SHEET_OFFSET = 0.25;
+
+/** A noisy sample of the sheet is off its neighbours' plane by up to this many
+ * sigmas of the noise. */
+constexpr double NOISE_SPREAD = 3.0;
+
+/** Of the \a candidates (free samples over the hole, their heights off the loop's
+ * quadratic given by \a residual), those on the loop's own sheet: taken from the
+ * loop inwards, the nearest to what is taken first (in the plane), each unless it
+ * is off the plane of the samples taken within \a spacing of it (in the plane) by
+ * more than SHEET_OFFSET of \a spacing and \a spread (the noise's). A candidate turned
+ * down stays free for another hole. The quadratic alone does not tell the sheets:
+ * over a round loop its height in the middle is free (any multiple of the circle's
+ * equation may be added), and it fitted one touching sphere's hole between the two
+ * caps, half a spacing apart. */
+template <typename Residual>
+std::vector<int>
+ownSheet(const detail::LoopPlane& hole,
+         const std::vector<int>& loop,
+         const std::vector<int>& candidates,
+         const std::vector<Eigen::Vector3d>& points,
+         const Residual& residual,
+         double spread,
+         double spacing)
+{
+  const std::size_t m = candidates.size();
+  if (m == 0 || !(spacing > 0.0))
+    return {};
+  // The loop's vertices and the candidates (from m on), in the plane, over a grid
+  // of cell \a spacing: the samples a candidate is checked against lie in the 3 x
+  // 3 cells round it, and a sample taken brings nearer those in the 5 x 5 round it.
+  std::vector<Eigen::Vector2d> x;
+  std::vector<double> height;
+  for (const int q : candidates) {
+    x.push_back(hole.flat(points[q]));
+    height.push_back(residual(q));
+  }
+  for (const int v : loop) {
+    x.push_back(hole.flat(points[v]));
+    height.push_back(residual(v));
+  }
+  using Cell = std::pair<long, long>;
+  const auto cell_of = [&](const Eigen::Vector2d& p) {
+    return Cell(static_cast<long>(std::floor(p.x() / spacing)),
+                static_cast<long>(std::floor(p.y() / spacing)));
+  };
+  std::map<Cell, std::vector<int>> candidates_in, taken_in;
+  for (std::size_t i = 0; i < m; ++i)
+    candidates_in[cell_of(x[i])].push_back(static_cast<int>(i));
+  const auto around = [&](const std::map<Cell, std::vector<int>>& grid,
+                          const Eigen::Vector2d& p,
+                          long rings,
+                          const auto& f) {
+    const Cell c = cell_of(p);
+    for (long dx = -rings; dx <= rings; ++dx)
+      for (long dy = -rings; dy <= rings; ++dy) {
+        const auto found = grid.find(Cell(c.first + dx, c.second + dy));
+        if (found != grid.end())
+          for (const int i : found->second)
+            f(i);
+      }
+  };
+  // Nearest first: a heap of (squared distance to the nearest sample taken,
+  // candidate), stale entries skipped.
+  std::vector<double> nearest(m, std::numeric_limits<double>::infinity());
+  std::vector<std::uint8_t> done(m, 0);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  const auto take = [&](int t) {
+    taken_in[cell_of(x[t])].push_back(t);
+    around(candidates_in, x[t], 2, [&](int i) {
+      const double d = (x[i] - x[t]).squaredNorm();
+      if (!done[i] && d < nearest[i]) {
+        nearest[i] = d;
+        queue.emplace(d, i);
+      }
+    });
+  };
+  for (std::size_t v = m; v < x.size(); ++v)
+    take(static_cast<int>(v));
+  std::vector<int> own;
+  for (std::size_t left = m; left > 0; --left) {
+    while (!queue.empty() && (done[queue.top().second] ||
+                              queue.top().first != nearest[queue.top().second]))
+      queue.pop();
+    // None within two cells of what is taken: the first left (a gap in the hole).
+    int next = 0;
+    if (queue.empty())
+      while (done[next])
+        ++next;
+    else
+      next = queue.top().second;
+    done[next] = 1;
+    // The height the samples taken within a spacing give at the candidate: their
+    // plane where they span one (least squares), else their mean.
+    Eigen::Matrix3d moments = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
+    around(taken_in, x[next], 1, [&](int t) {
+      const Eigen::Vector2d d = x[t] - x[next];
+      if (d.squaredNorm() < spacing * spacing) {
+        const Eigen::Vector3d a(1.0, d.x(), d.y());
+        moments += a * a.transpose();
+        weighted += a * height[t];
+      }
+    });
+    const double count = moments(0, 0);
+    bool over = false;
+    if (count > 0.0) {
+      double expected = weighted(0) / count;
+      const Eigen::Vector2d mean = moments.block<2, 1>(1, 0) / count;
+      const Eigen::Matrix2d spread_in_plane =
+          moments.block<2, 2>(1, 1) / count - mean * mean.transpose();
+      if (count >= 3.0 && Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+                              spread_in_plane, Eigen::EigenvaluesOnly)
+                                  .eigenvalues()(0) > 0.04 * spacing * spacing)
+        expected = moments.ldlt().solve(weighted)(0);
+      over =
+          std::abs(height[next] - expected) > std::max(SHEET_OFFSET * spacing, spread);
+    }
+    if (over)
+      continue;
+    own.push_back(candidates[next]);
+    take(next);
+  }
+  return own;
+}
+
+} // namespace
+
 HoleFilling
 fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<double>& spacing,
@@ -897,7 +1036,8 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
                           std::vector<std::vector<int>>& loops,
                           double reach,
                           std::size_t max_edges,
-                          const std::vector<std::uint8_t>& true_border)
+                          const std::vector<std::uint8_t>& true_border,
+                          double noise)
 {
   using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
   using Fb = CGAL::Triangulation_face_base_with_info_2<
@@ -965,6 +1105,9 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
       rim_spacing += spacing[loop[i]] / static_cast<double>(k);
     }
     const Eigen::VectorXd fit = design.colPivHouseholderQr().solve(height);
+    const auto residual = [&](int v) {
+      return (points[v] - hole.centre).dot(hole.normal) - monomials(points[v]).dot(fit);
+    };
     // The free samples over the hole within half a spacing of that height, reached
     // from the loop through the co-cone triangles.
     if (first.empty())
@@ -982,14 +1125,19 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
         if (used[q] || seen[q] == stamp)
           continue;
         seen[q] = stamp;
-        if (!hole.contains(points[q]) ||
-            std::abs((points[q] - hole.centre).dot(hole.normal) -
-                     monomials(points[q]).dot(fit)) > 0.5 * rim_spacing)
+        if (!hole.contains(points[q]) || std::abs(residual(q)) > 0.5 * rim_spacing)
           continue;
         inner.push_back(q);
         stack.push_back(q);
       }
     }
+    inner = ownSheet(hole,
+                     loop,
+                     inner,
+                     points,
+                     residual,
+                     NOISE_SPREAD * noise * rim_spacing,
+                     rim_spacing);
     if (inner.empty())
       return false;
     // The constrained Delaunay triangulation of the loop and the samples inside, in

@@ -273,7 +273,8 @@ closeUndersampledHoles(const std::vector<Eigen::Vector3d>& points,
                                      result.border_loops,
                                      parameters.hole_reach,
                                      parameters.max_hole_edges,
-                                     true_border));
+                                     true_border,
+                                     result.noise_level));
   };
   // What is left where the sampling is coarser across the rim than along it
   // (fillUndersampledHoles()): a hole no wider than hole_width rim triangles,

@@ -174,13 +174,16 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
  * The loop is projected onto its best-fit plane, where it must be a simple polygon;
  * the free samples inside it (reached from the loop through the co-cone triangles)
  * within half its local spacing of the quadratic height the loop's vertices fit over
- * that plane are the hole's (at a whole spacing, spheres 2 spacings apart lent one
- * hole a sample of the other); CGAL's constrained Delaunay triangulation of the polygon
- * and them, in the plane, gives the patch: its triangles inside the polygon, every new
- * edge at most \a reach local spacings long and new to the mesh, facing as the
- * mesh. Assumes the hole is a height field over the loop's plane (small against
- * the surface's curvature) and the other sheet, if any, more than half a spacing
- * from the loop's surface; a hole without free samples inside is left to the others.
+ * that plane are its candidates (at a whole spacing, spheres 2 spacings apart lent
+ * one hole a sample of the other), and of those the hole's are the loop's own sheet:
+ * taken from the loop inwards, each unless it stands over or under a sample taken
+ * (rising from it by more than half their distance, beyond the noise). CGAL's
+ * constrained Delaunay triangulation of the polygon and them, in the plane, gives
+ * the patch: its triangles inside the polygon, every new edge at most \a reach local
+ * spacings long and new to the mesh, facing as the mesh. Assumes the hole is a
+ * height field over the loop's plane (small against the surface's curvature) and
+ * another sheet within half a spacing of it, if any, farther from it than the noise;
+ * a hole without free samples inside is left to the others.
  * \param[in] points the vertex positions
  * \param[in] spacing per vertex its local spacing (localSpacing())
  * \param[in] cocone_triangles the co-cone triangles (VoronoiCells::triangles)
@@ -191,6 +194,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
  * \param[in] max_edges loops longer than this are left open
  * \param[in] true_border per vertex: on a true border, whose loop stays open;
  *            empty: none
+ * \param[in] noise the noise's sigma in local spacings (Result::noise_level): the
+ *            spread in height two samples of one sheet may have
  */
 HoleFilling
 fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
@@ -201,7 +206,8 @@ fillHolesWithInnerSamples(const std::vector<Eigen::Vector3d>& points,
                           std::vector<std::vector<int>>& loops,
                           double reach,
                           std::size_t max_edges,
-                          const std::vector<std::uint8_t>& true_border = {});
+                          const std::vector<std::uint8_t>& true_border = {},
+                          double noise = 0.0);
 
 /** \brief CGAL's advancing front reconstruction (Cohen-Steiner and Da; CGAL's
  * default plausibility: radius ratio bound 5, beta 0.52) of the points \a island
