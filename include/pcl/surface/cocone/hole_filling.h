@@ -176,8 +176,8 @@ fillHolesFromMesh(const std::vector<Eigen::Vector3d>& points,
  * within half its local spacing of the quadratic height the loop's vertices fit over
  * that plane are its candidates (at a whole spacing, spheres 2 spacings apart lent
  * one hole a sample of the other), and of those the hole's are the loop's own sheet:
- * taken from the loop inwards, each unless it stands over or under a sample taken
- * (rising from it by more than half their distance, beyond the noise). CGAL's
+ * taken from the loop inwards, each unless it stands over or under the samples
+ * taken round it (off their plane by a quarter spacing, beyond the noise). CGAL's
  * constrained Delaunay triangulation of the polygon and them, in the plane, gives
  * the patch: its triangles inside the polygon, every new edge at most \a reach local
  * spacings long and new to the mesh, facing as the mesh. Assumes the hole is a
