@@ -1984,13 +1984,9 @@ TEST(HoleFilling, LayersWithinASpacingOfALargerPieceGo)
   // (6 components, Euler 12), each within a spacing of the spheres' triangles.
   auto o = cocone_test::options(10000, 0.0, 1.0, false);
   o.seed = 2;
-  const auto touching = cocone_test::twoTouchingSpheres(o);
-  const auto t = pcl::cocone::run(
-      touching.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
-  const auto m = cocone_test::scoreMesh(touching, t);
-  std::printf("[ measured ] touching spheres, 10000 random samples, seed 2: %s\n",
-              m.str().c_str());
-  EXPECT_TRUE(cocone_test::closedSurface(m, 2, 4));
+  const Outcome touching =
+      reconstruct(cocone_test::twoTouchingSpheres(o), Parameters(), "random, seed 2");
+  EXPECT_TRUE(cocone_test::closedSurface(touching.mesh, 2, 4));
 }
 
 TEST(HoleFilling, NearlyTouchingSpheres)
@@ -2044,13 +2040,10 @@ TEST(HoleFilling, InnerSamplesOfTheOtherSheetStayOut)
   // other hole without them: 1 loop, Euler 3. Each hole takes its own sheet's.
   auto o = cocone_test::options(10000, 0.0, 1.0, true);
   o.seed = 1;
-  const auto s = cocone_test::twoTouchingSpheres(o);
-  const auto r = pcl::cocone::run(
-      s.points, pcl::cocone::Parameters(), pcl::cocone::Stages::RECONSTRUCTION);
-  const auto m = cocone_test::scoreMesh(s, r);
-  std::printf("[ measured ] touching spheres, 10000 even samples, seed 1: %s\n",
-              m.str().c_str());
-  EXPECT_TRUE(cocone_test::closedSurface(m, 2, 4));
+  const Outcome touching =
+      reconstruct(cocone_test::twoTouchingSpheres(o), Parameters(), "even, seed 1");
+  const Result& r = touching.result;
+  EXPECT_TRUE(cocone_test::closedSurface(touching.mesh, 2, 4));
   EXPECT_GT(r.counts.holes_filled, 1u);
   // No triangle joins the spheres (centred on the x axis either side of 0).
   std::size_t joining = 0;
