@@ -51,8 +51,11 @@ struct NoiseAnalysis {
  * are; a point of a thin part, a crease or a coarse tube is not, since its
  * neighbours sit as far off their own fits; nor a point beside its neighbours rather
  * than above them (at a border, where the neighbours' fit extrapolated misses it),
- * unless it is isolated (its spacing three times theirs). Outliers next to each other
- * hide one another, so the search runs again among the neighbours that are not
+ * unless it is isolated (its spacing three times theirs); nor, in a cloud whose level
+ * is at most 0.1, a point with samples of a sheet of its own round it (three off the
+ * jet on its side, on a plane with it: a second sheet closer than the spacing, whose
+ * samples may have only the other sheet's among their nearest). Outliers next to each
+ * other hide one another, so the search runs again among the neighbours that are not
  * outliers, up to three rounds. Assumes a surface sample with noise far below the
  * spacing of a dense region's neighbours in the normal direction at the outliers.
  * \param[in] points the Delaunay vertices
