@@ -62,6 +62,8 @@ struct Plane {
   double mean_square = 0.0;
   /** Mean squared distance from the centroid along the plane. */
   double spread = 0.0;
+  /** Of that, the part along tangent_v (the narrower way). */
+  double narrow_spread = 0.0;
 };
 
 Plane
@@ -79,6 +81,7 @@ fitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, int count)
   plane.tangent_v = solver.eigenvectors().col(1);
   plane.mean_square = std::max(solver.eigenvalues()(0), 0.0);
   plane.spread = solver.eigenvalues()(1) + solver.eigenvalues()(2);
+  plane.narrow_spread = solver.eigenvalues()(1);
   return plane;
 }
 
@@ -476,21 +479,24 @@ constexpr double SHEET_NOISE_LEVEL = 0.1;
 constexpr double COMPANION_REACH = 4.0;
 
 /** Whether p, found an outlier over its near neighbours in \a list (isOutlier(),
- * not isolated), has SHEET_COMPANIONS samples of a sheet of its own round it
- * (\a grid holds them): samples off its neighbours' jet on its side by more than a
- * quarter of their spacing, within COMPANION_REACH of their spacing, which with
- * p lie on a plane (within that quarter) that they span both ways. Off the jet,
- * not off the plane: on a curved surface the samples a few spacings round an
- * outlier rise off its neighbours' plane to its height. */
+ * not isolated; \a around_spacing their spacing, aroundSpacing()), has
+ * SHEET_COMPANIONS samples of a sheet of its own round it (\a grid holds them):
+ * samples off its neighbours' jet on its side by more than a quarter of their
+ * spacing, within COMPANION_REACH of their spacing, which with p lie on a plane
+ * (within that quarter) that they span both ways. Off the jet, not off the plane:
+ * on a curved surface the samples a few spacings round an outlier rise off its
+ * neighbours' plane to its height. The jet is fitted again, as isOutlier() did:
+ * kept for every point judged, it would cost a jet's size per point for the few
+ * found. */
 bool
 onSheetOfItsOwn(const std::vector<Eigen::Vector3d>& points,
                 const std::array<int, NEAREST>& list,
                 int p,
                 const Neighbourhoods& hoods,
+                double around_spacing,
                 const LocalGrid& grid)
 {
   const int k = hoods.near[p];
-  const double around_spacing = aroundSpacing(list, k, hoods);
   const double band = 0.25 * around_spacing;
   const double across = COMPANION_REACH * around_spacing;
   const Jet jet(points, points[p], list.data(), k, false, 9);
@@ -513,12 +519,9 @@ onSheetOfItsOwn(const std::vector<Eigen::Vector3d>& points,
   // Their plane with p (the origin adds zeros): p on it, they on it, spread both
   // ways along it (the smaller axis at least a fifth of the larger: not a streak).
   const Plane sheet = fitPlane(sum, outer, companions + 1);
-  const Eigen::Vector3d axes =
-      (outer / (companions + 1) - sheet.centroid * sheet.centroid.transpose())
-          .selfadjointView<Eigen::Lower>()
-          .eigenvalues();
   return std::abs(sheet.normal.dot(sheet.centroid)) <= band &&
-         sheet.mean_square <= band * band && axes(1) > 0.04 * axes(2);
+         sheet.mean_square <= band * band &&
+         sheet.narrow_spread > 0.04 * (sheet.spread - sheet.narrow_spread);
 }
 
 /** What isOutlier() finds. */
@@ -605,20 +608,24 @@ findOutliers(const std::vector<Eigen::Vector3d>& points,
   // them, one pass over the points).
   std::vector<std::ptrdiff_t> near;
   std::vector<Eigen::Vector3d> centres;
-  double cell = 0.0;
+  std::vector<double> around;
   for (std::ptrdiff_t i = 0; i < n; ++i)
     if (sheets && verdicts[i] == Verdict::OUTLIER) {
-      near.push_back(i);
-      centres.push_back(points[candidates[i]]);
       const int p = candidates[i];
-      cell = std::max(cell,
-                      COMPANION_REACH * aroundSpacing(lists[p], hoods.near[p], hoods));
+      near.push_back(i);
+      centres.push_back(points[p]);
+      around.push_back(aroundSpacing(lists[p], hoods.near[p], hoods));
     }
-  if (!near.empty() && cell > 0.0 && std::isfinite(cell)) {
+  const double cell =
+      near.empty() ? 0.0
+                   : COMPANION_REACH * *std::max_element(around.begin(), around.end());
+  if (cell > 0.0 && std::isfinite(cell)) {
     const LocalGrid grid(points, centres, cell);
-    for (const std::ptrdiff_t i : near)
-      if (onSheetOfItsOwn(points, lists[candidates[i]], candidates[i], hoods, grid))
-        verdicts[i] = Verdict::SURFACE;
+    for (std::size_t j = 0; j < near.size(); ++j) {
+      const int p = candidates[near[j]];
+      if (onSheetOfItsOwn(points, lists[p], p, hoods, around[j], grid))
+        verdicts[near[j]] = Verdict::SURFACE;
+    }
   }
   std::vector<int> outliers;
   for (std::ptrdiff_t i = 0; i < n; ++i)
