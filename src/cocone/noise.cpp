@@ -734,7 +734,8 @@ NoiseAnalysis
 analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, NEAREST>>& nearest,
              int threads,
-             const std::vector<std::uint8_t>& counted)
+             const std::vector<std::uint8_t>& counted,
+             bool not_noise)
 {
   const auto n = static_cast<std::ptrdiff_t>(points.size());
   NoiseAnalysis out;
@@ -770,7 +771,7 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> all(n);
   for (std::ptrdiff_t p = 0; p < n; ++p)
     all[p] = static_cast<int>(p);
-  const bool sheets = out.cloud_level <= SHEET_NOISE_LEVEL;
+  const bool sheets = not_noise || out.cloud_level <= SHEET_NOISE_LEVEL;
   std::vector<int> found =
       confirmOutliers(points, nearest, hoods, all, std::move(verdicts), sheets);
   std::vector<int>().swap(all);

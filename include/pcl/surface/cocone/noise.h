@@ -63,12 +63,16 @@ struct NoiseAnalysis {
  * \param[in] threads threads to compute with (the result does not depend on them)
  * \param[in] counted per vertex: counts in the cloud's level (e.g. a tile's core,
  *            not its halo); empty: every vertex
+ * \param[in] not_noise the level is known not to be noise (the smoothing would not
+ *            take it out): the samples of a sheet of their own are kept whatever
+ *            the level
  */
 NoiseAnalysis
 analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
              int threads = 1,
-             const std::vector<std::uint8_t>& counted = {});
+             const std::vector<std::uint8_t>& counted = {},
+             bool not_noise = false);
 
 /** \brief The noise level of the cloud (NoiseAnalysis::cloud_level) read again on
  * other positions of the same points, with the same neighbours, on one point in 4:
