@@ -251,7 +251,7 @@ detectBoundary(const VoronoiCells& cells,
     arcs.insert(arcs.end(), f.begin(), f.end());
   std::vector<std::vector<std::pair<int, int>>>().swap(found);
   std::vector<int> head(arcs.size());
-  const std::vector<std::uint32_t> first = detail::countingSort(
+  const detail::LargeVector<std::uint32_t> first = detail::countingSort(
       arcs.size(),
       n,
       threads,

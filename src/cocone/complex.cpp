@@ -151,7 +151,7 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Edges: the incidences grouped by edge once. Incidence (t, k) runs from corner k
   // to corner k + 1, so it is the edge opposite corner k + 2.
-  const std::vector<std::uint64_t> word =
+  const detail::LargeVector<std::uint64_t> word =
       detail::groupEdgeIncidences(triangles_, edges_, edge_first_, threads);
   triangle_edges_.resize(m);
   edge_triangles_.resize(word.size());
@@ -181,7 +181,7 @@ TriangleComplex::TriangleComplex(const std::vector<Eigen::Vector3d>& points,
 
   // Vertex -> triangles, in ascending order.
   vertex_triangles_.resize(3 * m);
-  const std::vector<std::uint32_t> start = detail::groupCorners(
+  const detail::LargeVector<std::uint32_t> start = detail::groupCorners(
       triangles_,
       points_.size(),
       threads,

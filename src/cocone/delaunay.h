@@ -11,6 +11,8 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "allocator.h"
+
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -34,32 +36,6 @@ struct BuildCell {
   static constexpr int FREE = -2;
   std::array<int, 4> v;
   std::array<std::uint32_t, 4> n;
-};
-
-/** An allocator that default-initializes: a vector of trivial cells sized ahead of
- * use costs no memory until its cells are written. */
-template <typename T>
-struct DefaultInitAllocator : std::allocator<T> {
-  template <typename U>
-  struct rebind {
-    using other = DefaultInitAllocator<U>;
-  };
-  DefaultInitAllocator() = default;
-  template <typename U>
-  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept
-  {}
-  template <typename U>
-  void
-  construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value)
-  {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <typename U, typename... Args>
-  void
-  construct(U* p, Args&&... args)
-  {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
 };
 
 /** The cells as built, freed ones included (v[0] == BuildCell::FREE). */

@@ -39,7 +39,7 @@ incidenceCorner(std::uint64_t word)
  * put(t, k, place).
  * \return per key b, where its corners begin; then the end (3 m) */
 template <typename Key, typename Put>
-std::vector<std::uint32_t>
+LargeVector<std::uint32_t>
 groupCorners(const std::vector<Triangle>& triangles,
              std::size_t buckets,
              int threads,
@@ -65,7 +65,7 @@ groupCorners(const std::vector<Triangle>& triangles,
  * \param[out] edges the distinct edges, end points ascending, by lower then higher
  * \param[out] first per edge e, its incidences [first[e], first[e + 1]) of the result
  */
-inline std::vector<std::uint64_t>
+inline LargeVector<std::uint64_t>
 groupEdgeIncidences(const std::vector<Triangle>& triangles,
                     std::vector<std::array<int, 2>>& edges,
                     std::vector<std::size_t>& first,
@@ -76,8 +76,8 @@ groupEdgeIncidences(const std::vector<Triangle>& triangles,
   for (const auto& t : triangles)
     highest = std::max({highest, t[0], t[1], t[2]});
   const std::size_t buckets = static_cast<std::size_t>(highest) + 1;
-  std::vector<std::uint64_t> word(3 * m);
-  const std::vector<std::uint32_t> start = groupCorners(
+  LargeVector<std::uint64_t> word(3 * m);
+  const LargeVector<std::uint32_t> start = groupCorners(
       triangles,
       buckets,
       threads,
@@ -133,7 +133,7 @@ void
 sortByVertexIds(std::vector<T>& items, std::size_t n, const Key& key, int threads = 1)
 {
   std::vector<T> sorted(items.size());
-  const std::vector<std::uint32_t> start = countingSort(
+  const LargeVector<std::uint32_t> start = countingSort(
       items.size(),
       n,
       threads,

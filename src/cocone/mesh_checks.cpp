@@ -20,7 +20,7 @@ using detail::DisjointSets;
 
 EdgeIncidences::EdgeIncidences(const std::vector<Triangle>& oriented, int threads)
 {
-  const std::vector<std::uint64_t> word =
+  const detail::LargeVector<std::uint64_t> word =
       detail::groupEdgeIncidences(oriented, edges, first, threads);
   triangle.resize(word.size());
   forward.resize(word.size());
@@ -144,7 +144,7 @@ vertexFans(const std::vector<Triangle>& oriented,
   // triangles share an edge at the vertex.
   const std::size_t m = oriented.size();
   std::vector<int> corners(3 * m);
-  const std::vector<std::uint32_t> corner_first = detail::groupCorners(
+  const detail::LargeVector<std::uint32_t> corner_first = detail::groupCorners(
       oriented,
       num_vertices,
       threads,

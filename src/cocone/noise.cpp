@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "allocator.h"
 #include "parallel.h"
 #include "points.h"
 
@@ -108,7 +109,7 @@ median(std::vector<T> values)
 /** The first and second moments of the points P[i] - origin over \a neighbours
  * (the origin adds zeros), and the largest squared distance among them. */
 struct Moments {
-  Moments(const std::vector<Eigen::Vector3d>& P,
+  Moments(const Eigen::Vector3d* P,
           const Eigen::Vector3d& origin,
           const int* neighbours,
           int k)
@@ -133,7 +134,7 @@ class Jet {
 public:
   /** The jet of \a P[i] - origin over \a neighbours, and of the origin itself when
    * \a with_origin. */
-  Jet(const std::vector<Eigen::Vector3d>& P,
+  Jet(const Eigen::Vector3d* P,
       const Eigen::Vector3d& origin,
       const int* neighbours,
       int k,
@@ -149,7 +150,7 @@ public:
   {}
 
   /** The same, with the \a moments of the neighbours about the origin given. */
-  Jet(const std::vector<Eigen::Vector3d>& P,
+  Jet(const Eigen::Vector3d* P,
       const Eigen::Vector3d& origin,
       const int* neighbours,
       int k,
@@ -533,7 +534,7 @@ onSheetOfItsOwn(const std::vector<Eigen::Vector3d>& points,
   const int k = hoods.near[p];
   const double band = 0.25 * around_spacing;
   const double across = COMPANION_REACH * around_spacing;
-  const Jet jet(points, points[p], list.data(), k, false, 9);
+  const Jet jet(points.data(), points[p], list.data(), k, false, 9);
   const double own = jet.residual(points[p]);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
@@ -656,7 +657,7 @@ isOutlier(const std::vector<Eigen::Vector3d>& points,
   // A jet of 9 neighbours at least (a flying pixel has fewer near ones than a
   // surface point): a plane of a few misses a curved surface's point by as much as
   // a pixel, so only an isolated point is judged by one.
-  const Jet jet(points, points[p], list.data(), k, false, 9);
+  const Jet jet(points.data(), points[p], list.data(), k, false, 9);
   if (!jet.curved() && !isolated)
     return verdict;
   const double off = (jet.project(points[p]) - points[p]).norm();
@@ -722,7 +723,7 @@ findOutliers(const std::vector<Eigen::Vector3d>& points,
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const int p = candidates[i];
-    const Moments moments(points, points[p], lists[p].data(), hoods.near[p]);
+    const Moments moments(points.data(), points[p], lists[p].data(), hoods.near[p]);
     verdicts[i] = isOutlier(points, lists[p], p, hoods, moments);
   }
   return confirmOutliers(points, lists, hoods, candidates, std::move(verdicts), sheets);
@@ -754,9 +755,9 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
     if (k < 3)
       continue;
     const int* list = nearest[p].data();
-    const Moments moments(points, points[p], list, k);
-    out.level[p] =
-        static_cast<float>(noiseLevel(Jet(points, points[p], list, k, moments, true)));
+    const Moments moments(points.data(), points[p], list, k);
+    out.level[p] = static_cast<float>(
+        noiseLevel(Jet(points.data(), points[p], list, k, moments, true)));
     verdicts[p] = isOutlier(points, nearest[p], static_cast<int>(p), hoods, moments);
   }
   if (counted.empty())
@@ -869,8 +870,8 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
     double spacing = 0.0;
     const int k = nearNeighbours(points, list, p, &spacing);
     if (k >= 3)
-      level[i] =
-          static_cast<float>(noiseLevel(Jet(points, points[p], list.data(), k, true)));
+      level[i] = static_cast<float>(
+          noiseLevel(Jet(points.data(), points[p], list.data(), k, true)));
   }
   level.erase(
       std::remove_if(level.begin(), level.end(), [](float l) { return std::isnan(l); }),
@@ -889,8 +890,8 @@ smoothPoints(const std::vector<Eigen::Vector3d>& points,
   const auto is_outlier = [&](int q) { return !outlier.empty() && outlier[q]; };
   // The neighbourhoods: the K nearest of the two-ring, by distance, then id.
   constexpr int K = SMOOTHING_NEIGHBOURS;
-  std::vector<int> neighbours(static_cast<std::size_t>(n) * K, -1);
-  std::vector<int> size(n, 0);
+  detail::LargeVector<int> neighbours(static_cast<std::size_t>(n) * K, -1);
+  detail::LargeVector<int> size(n, 0);
   detail::forEachRange(
       n, detail::partsFor(n, threads), [&](std::size_t begin, std::size_t end, int) {
         TwoRing ring(points, nearest, outlier);
@@ -899,15 +900,19 @@ smoothPoints(const std::vector<Eigen::Vector3d>& points,
             size[p] = ring.gather(static_cast<int>(p), K, &neighbours[p * K]);
       });
 
-  std::vector<Eigen::Vector3d> current = points, next(points.size());
+  // Each round projects the previous round's points; the last writes the result.
+  std::vector<Eigen::Vector3d> result(points.size());
+  detail::LargeVector<Eigen::Vector3d> scratch(iterations > 1 ? points.size() : 0);
+  const Eigen::Vector3d* from = points.data();
   for (int it = 0; it < iterations; ++it) {
+    Eigen::Vector3d* const to =
+        (iterations - it) % 2 == 1 ? result.data() : scratch.data();
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
     for (std::ptrdiff_t p = 0; p < n; ++p)
-      next[p] = Jet(current, current[p], &neighbours[p * K], size[p], true)
-                    .project(current[p]);
-    std::swap(current, next);
+      to[p] = Jet(from, from[p], &neighbours[p * K], size[p], true).project(from[p]);
+    from = to;
   }
-  return current;
+  return result;
 }
 
 } // namespace cocone

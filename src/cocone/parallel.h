@@ -8,6 +8,8 @@
 
 #pragma once
 
+#include "allocator.h"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -123,7 +125,7 @@ forEachTask(std::size_t count, int workers, const Body& body)
  * of the items: the same places.
  * \return per key b, where its items begin; then the end (count) */
 template <typename Key, typename Put>
-std::vector<std::uint32_t>
+LargeVector<std::uint32_t>
 countingSort(
     std::size_t count, std::size_t buckets, int threads, const Key& key, const Put& put)
 {
@@ -139,7 +141,7 @@ countingSort(
     for (std::size_t i = begin; i < end; ++i)
       ++counted[key(i)];
   });
-  std::vector<std::uint32_t> start(buckets + 1);
+  LargeVector<std::uint32_t> start(buckets + 1);
   std::uint32_t total = 0;
   for (std::size_t b = 0; b < buckets; ++b) {
     start[b] = total;

@@ -184,14 +184,6 @@ triangleCircumcenter(const Eigen::Vector3d& a,
 
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-#define COCONE_UNDER_ASAN
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define COCONE_UNDER_ASAN
-#endif
-#endif
-
 /** Hand glibc's free memory back to the system: glibc keeps freed blocks mapped (a
  * small block left on top of a heap keeps the rest too), and what CGAL's planar
  * triangulation allocated lies in the malloc arena of the thread that built it.

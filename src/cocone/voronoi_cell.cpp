@@ -5,6 +5,7 @@
 
 #include <pcl/surface/cocone/voronoi_cell.h>
 
+#include "allocator.h"
 #include "edge_sort.h"
 #include "points.h"
 
@@ -107,13 +108,13 @@ public:
   void
   release()
   {
-    std::vector<std::array<float, K>>().swap(d2_);
+    detail::LargeVector<std::array<float, K>>().swap(d2_);
   }
 
 private:
   const std::vector<Eigen::Vector3d>& P_;
   std::vector<std::array<int, K>>& ids_;
-  std::vector<std::array<float, K>> d2_;
+  detail::LargeVector<std::array<float, K>> d2_;
 };
 
 /** Coplanar points: every Voronoi cell is a prism over the planar Voronoi polygon. */
@@ -124,7 +125,7 @@ planarCells(const Triangulation& dt, double cocone_angle)
   const std::size_t n = P.size();
   VoronoiCells vc;
   vc.on_hull.assign(n, 0);
-  std::vector<double> radius(n, 0.0);
+  detail::LargeVector<double> radius(n, 0.0);
   std::array<int, 3> first{std::numeric_limits<int>::max(), 0, 0};
   NearestNeighbours nearest(P, vc.nearest);
   forEachCell(
@@ -365,7 +366,7 @@ computePoles(const Triangulation& dt, double cocone_angle, unsigned int num_thre
   // direction needs. (A sampled closed surface can have half its points on the
   // hull.)
   constexpr double FIXED = 4294967296.0;
-  std::vector<int> slot(n, -1);
+  detail::LargeVector<int> slot(n, -1);
   std::vector<std::array<std::int64_t, 3>> sum;
   forEachHullFacet(dt, [&](const HullFacet& h) {
     const Eigen::Vector3d normal = outwardNormal(P, h.v, h.outward);
@@ -429,7 +430,7 @@ computeCocones(const Triangulation& dt,
   std::vector<double>& width = vc.width;
   neg2.assign(n, 0.0);
   width.assign(n, 0.0);
-  std::vector<std::uint8_t> met(n, 0);
+  detail::LargeVector<std::uint8_t> met(n, 0);
   // Collected straight into the result, a batch per thread at a time: a sampled
   // surface has about two per point, which the reservation mostly holds, and no
   // second copy of them is ever made.
