@@ -3,7 +3,8 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  *
  * Tasks on threads (the tiles, the two scales): each task once, and an exception
- * in a task thrown to the caller, the same whatever the threads.
+ * in a task thrown to the caller, the same whatever the threads. The allocator of
+ * the large arrays.
  */
 
 #include <gtest/gtest.h>
@@ -11,11 +12,13 @@
 #include "parallel.h"
 
 #include <atomic>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 using pcl::cocone::detail::forEachTask;
+using pcl::cocone::detail::LargeVector;
 
 TEST(Parallel, EveryTaskRunsOnce)
 {
@@ -61,4 +64,31 @@ TEST(Parallel, OutOfMemoryInATaskReachesTheCaller)
                                throw std::bad_alloc();
                            }),
                std::bad_alloc);
+}
+
+TEST(LargeAllocator, ArraysKeepTheirValuesAcrossTheMappedSize)
+{
+  // 40 MB: mapped on its own (32 MB or more), aligned to a huge page outside
+  // AddressSanitizer; grown past its capacity, then shrunk below the mapped size.
+  constexpr std::size_t n = 5000000;
+  LargeVector<std::uint64_t> values(n);
+  for (std::size_t i = 0; i < n; ++i)
+    values[i] = i * 2654435761u;
+#ifndef COCONE_UNDER_ASAN
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(values.data()) %
+                pcl::cocone::detail::HUGE_PAGE,
+            0u);
+#endif
+  values.reserve(values.capacity() + 1);
+  values.push_back(7);
+  values.resize(1000);
+  values.shrink_to_fit();
+  ASSERT_EQ(values.size(), 1000u);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    ASSERT_EQ(values[i], i * 2654435761u) << i;
+  LargeVector<std::uint64_t> copy(n, 3);
+  copy.swap(values);
+  EXPECT_EQ(values.size(), n);
+  EXPECT_EQ(values[n - 1], 3u);
+  EXPECT_EQ(copy[999], std::uint64_t{999} * 2654435761u);
 }
