@@ -27,6 +27,12 @@
 #endif
 #endif
 
+// Large arrays are mapped on their own where the system takes the advice of huge
+// pages, and not under AddressSanitizer, whose heap checks them.
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(COCONE_UNDER_ASAN)
+#define COCONE_MAP_LARGE_ARRAYS
+#endif
+
 namespace pcl {
 namespace cocone {
 namespace detail {
@@ -65,7 +71,7 @@ struct LargeAllocator {
   T*
   allocate(std::size_t n)
   {
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(COCONE_UNDER_ASAN)
+#ifdef COCONE_MAP_LARGE_ARRAYS
     if (mapped(n)) {
       // A huge page more than asked, of which the part aligned to one is kept.
       const std::size_t size = roundUp(n * sizeof(T));
@@ -94,7 +100,7 @@ struct LargeAllocator {
   void
   deallocate(T* p, std::size_t n) noexcept
   {
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(COCONE_UNDER_ASAN)
+#ifdef COCONE_MAP_LARGE_ARRAYS
     if (mapped(n)) {
       munmap(p, roundUp(n * sizeof(T)));
       return;

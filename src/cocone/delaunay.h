@@ -15,9 +15,6 @@
 
 #include <array>
 #include <cstdint>
-#include <memory>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 namespace pcl {
