@@ -9,6 +9,8 @@
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/noise.h>
 #include <pcl/surface/cocone/pipeline.h>
+#include <pcl/surface/cocone/triangulation.h>
+#include <pcl/surface/cocone/voronoi_cell.h>
 
 #include <gtest/gtest.h>
 
@@ -256,6 +258,83 @@ TEST(Noise, KurtosisOfTheDisplacements)
   EXPECT_NEAR(pcl::cocone::displacementKurtosis(before, two, outlier), 1.0, 1e-9);
   EXPECT_GT(pcl::cocone::displacementKurtosis(before, two, {}), 100.0);
   EXPECT_EQ(pcl::cocone::displacementKurtosis(before, before, {}), 0.0);
+}
+
+namespace {
+
+/** The noise analysis of the unique \a points (vertex v is points[v]) over their
+ * nearest Delaunay neighbours; empty where there are none. */
+pcl::cocone::NoiseAnalysis
+analyze(const std::vector<Eigen::Vector3d>& points)
+{
+  const pcl::cocone::Triangulation dt = pcl::cocone::triangulate(points);
+  const pcl::cocone::VoronoiCells cells =
+      pcl::cocone::computePoles(dt, Parameters().cocone_angle);
+  if (cells.nearest.size() != dt.points.size())
+    return {};
+  return pcl::cocone::analyzeNoise(dt.points, cells.nearest);
+}
+
+} // namespace
+
+TEST(Noise, LevelReadsTheNoiseWhicheverWayTheCloudIsTurned)
+{
+  // The level reads the Gaussian noise's sigma in spacings (noise.h: about 0.30,
+  // 0.49 and 0.87 for 0.3, 0.5 and 1 on random samples), clean samples below 0.05,
+  // and it does not depend on how the cloud is turned: the jets' planes come out of
+  // any covariance, the singular ones of axis-aligned flat neighbourhoods too.
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized())
+          .toRotationMatrix();
+  for (const double sigma : {0.0, 0.3, 0.5, 1.0}) {
+    const Sample s = cocone_test::torus(options(20000, sigma, 1.0, false));
+    std::vector<Eigen::Vector3d> turned;
+    for (const auto& p : s.points)
+      turned.push_back(turn * p);
+    const pcl::cocone::NoiseAnalysis given = analyze(s.points), other = analyze(turned);
+    std::printf("[ measured ] torus, sigma %.1f: level %.3f, turned %.3f\n",
+                sigma,
+                given.cloud_level,
+                other.cloud_level);
+    if (sigma == 0.0)
+      EXPECT_LT(given.cloud_level, 0.05);
+    else {
+      EXPECT_GT(given.cloud_level, 0.8 * sigma);
+      EXPECT_LT(given.cloud_level, 1.15 * sigma);
+    }
+    // The triangulation of the turned points may differ where samples are nearly
+    // co-spherical, not the levels of nearly all of them.
+    ASSERT_EQ(given.level.size(), other.level.size());
+    std::size_t agree = 0;
+    for (std::size_t i = 0; i < given.level.size(); ++i)
+      agree += std::abs(given.level[i] - other.level[i]) <=
+               1e-5f * std::max(1.0f, given.level[i]);
+    EXPECT_GE(agree, given.level.size() * 99 / 100) << "sigma " << sigma;
+  }
+
+  // A plane in z = 0 reads no noise (every neighbourhood's covariance singular);
+  // points filling a ball are no surface and read above noise of a spacing.
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> plane, ball;
+  while (plane.size() < 5000)
+    plane.emplace_back(coordinate(random), coordinate(random), 0.0);
+  while (ball.size() < 5000) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    if (p.norm() <= 1.0)
+      ball.push_back(p);
+  }
+  const pcl::cocone::NoiseAnalysis flat = analyze(plane);
+  ASSERT_EQ(flat.level.size(), plane.size());
+  const float flat_level = *std::max_element(flat.level.begin(), flat.level.end());
+  EXPECT_LT(flat_level, 1e-4f); // the rounding of an exact fit's residual
+  const pcl::cocone::NoiseAnalysis volume = analyze(ball);
+  for (const float level : volume.level)
+    ASSERT_TRUE(std::isfinite(level));
+  std::printf("[ measured ] plane: largest level %.2g; ball: level %.2f\n",
+              flat_level,
+              volume.cloud_level);
+  EXPECT_GT(volume.cloud_level, 1.2);
 }
 
 TEST(Noise, CoarseShapesAreNotSmoothedAway)
