@@ -230,7 +230,7 @@ TEST_P(NoisySurface, TopologyOfTheTrueSurface)
 
 INSTANTIATE_TEST_SUITE_P(
     Noise, NoisySurface, ::testing::ValuesIn(noisyCases()), [](const auto& info) {
-      const int tenths = int(info.param.sigma * 10.0 + 0.5);
+      const int tenths = static_cast<int>(std::lround(info.param.sigma * 10.0));
       return std::string(info.param.surface.name) + "_sigma_" +
              std::to_string(tenths / 10) + "_" + std::to_string(tenths % 10) +
              (info.param.even ? "_even" : "");
