@@ -66,15 +66,24 @@ struct Plane {
   double narrow_spread = 0.0;
 };
 
+/** The centroid and covariance of points given by their sums relative to an
+ * origin: what fitPlane(), fitJetPlane() and the outlier test's bound read. */
+struct Scatter {
+  Scatter(const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, int count)
+  : centroid(sum / count), covariance(outer / count - centroid * centroid.transpose())
+  {}
+
+  Eigen::Vector3d centroid;
+  Eigen::Matrix3d covariance;
+};
+
 Plane
-fitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, int count)
+fitPlane(const Scatter& scatter)
 {
   Plane plane;
-  plane.centroid = sum / count;
-  const Eigen::Matrix3d covariance =
-      outer / count - plane.centroid * plane.centroid.transpose();
+  plane.centroid = scatter.centroid;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(covariance);
+  solver.computeDirect(scatter.covariance);
   // Ascending eigenvalues: the smallest's vector is the normal.
   plane.normal = solver.eigenvectors().col(0);
   plane.tangent_u = solver.eigenvectors().col(2);
@@ -150,18 +159,16 @@ smallestEigenpair(const Eigen::Matrix3d& S, double* l0, Eigen::Vector3d* normal)
  * some unit tangents (a jet over the plane does not depend on which), from
  * smallestEigenpair() where it answers; fitPlane()'s otherwise. */
 Plane
-fitJetPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, int count)
+fitJetPlane(const Scatter& scatter)
 {
-  const Eigen::Vector3d centroid = sum / count;
-  const Eigen::Matrix3d covariance = outer / count - centroid * centroid.transpose();
-  const double trace = covariance.trace();
+  const double trace = scatter.covariance.trace();
   double l0 = 0.0;
   Eigen::Vector3d normal;
   if (!(trace > 0.0) || !std::isfinite(trace) ||
-      !smallestEigenpair(covariance * (1.0 / trace), &l0, &normal))
-    return fitPlane(sum, outer, count);
+      !smallestEigenpair(scatter.covariance * (1.0 / trace), &l0, &normal))
+    return fitPlane(scatter);
   Plane plane;
-  plane.centroid = centroid;
+  plane.centroid = scatter.centroid;
   plane.normal = normal;
   plane.tangent_u = normal.unitOrthogonal();
   plane.tangent_v = normal.cross(plane.tangent_u);
@@ -293,7 +300,8 @@ public:
     const int points = k + (with_origin ? 1 : 0);
     if (points < 3 || radius2 == 0.0)
       return;
-    plane_ = fitJetPlane(moments.sum, moments.outer, points); // the origin adds zeros
+    // The origin adds zeros to the sums.
+    plane_ = fitJetPlane(Scatter(moments.sum, moments.outer, points));
     planar_ = true;
     mean_square_ = plane_.mean_square;
     if (points > 3)
@@ -688,7 +696,7 @@ onSheetOfItsOwn(const std::vector<Eigen::Vector3d>& points,
     return false;
   // Their plane with p (the origin adds zeros): p on it, they on it, spread both
   // ways along it (the smaller axis at least a fifth of the larger: not a streak).
-  const Plane sheet = fitPlane(sum, outer, companions + 1);
+  const Plane sheet = fitPlane(Scatter(sum, outer, companions + 1));
   return std::abs(sheet.normal.dot(sheet.centroid)) <= band &&
          sheet.mean_square <= band * band &&
          sheet.narrow_spread > 0.04 * (sheet.spread - sheet.narrow_spread);
@@ -757,16 +765,15 @@ isOutlier(const std::vector<Eigen::Vector3d>& points,
   // of the points are answered without the plane (on a clean million: the noise
   // analysis 0.93 -> 0.72 s). The margin keeps the answer the plane's own where the
   // two distances tie.
-  const Eigen::Vector3d centroid = moments.sum / k;
-  if (!(centroid.norm() > 0.25 * around_spacing * (1.0 - 1e-9)))
+  const Scatter neighbours(moments.sum, moments.outer, k);
+  if (!(neighbours.centroid.norm() > 0.25 * around_spacing * (1.0 - 1e-9)))
     return verdict;
   // Nor, provably, farther from their plane than a quarter spacing, the
   // decomposition spared: all but 2 of the rest on a clean million.
-  if (offsetProvablyWithin(moments.outer / k - centroid * centroid.transpose(),
-                           centroid,
-                           0.25 * around_spacing))
+  if (offsetProvablyWithin(
+          neighbours.covariance, neighbours.centroid, 0.25 * around_spacing))
     return verdict;
-  const Plane without = fitPlane(moments.sum, moments.outer, k);
+  const Plane without = fitPlane(neighbours);
   const double offset = std::abs(without.normal.dot(without.centroid));
   // Beside its neighbours rather than above them: p's foot on their plane is off
   // their centroid by more than its height, or by more than 0.8 of their RMS spread.
