@@ -19,23 +19,37 @@ namespace pcl {
 namespace cocone {
 
 std::vector<double>
-localSpacing(const std::vector<Eigen::Vector3d>& points,
-             const VoronoiCells& cells,
-             int threads)
+meanSpacing(const std::vector<Eigen::Vector3d>& points,
+            const VoronoiCells& cells,
+            int threads)
 {
-  constexpr int K = 6;
   const auto n = static_cast<std::ptrdiff_t>(points.size());
   std::vector<double> mean(n, 0.0);
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)
   for (std::ptrdiff_t v = 0; v < n; ++v)
-    mean[v] =
-        detail::meanNeighbourDistance(points, cells.nearest[v], static_cast<int>(v), K);
+    mean[v] = detail::meanNeighbourDistance(
+        points, cells.nearest[v], static_cast<int>(v), detail::SPACING_NEIGHBOURS);
+  return mean;
+}
+
+std::vector<double>
+localSpacing(const VoronoiCells& cells, const std::vector<double>& mean, int threads)
+{
+  const auto n = static_cast<std::ptrdiff_t>(mean.size());
   std::vector<double> s = mean;
 #pragma omp parallel for num_threads(threads) schedule(static, 16384)
   for (std::ptrdiff_t v = 0; v < n; ++v)
-    for (int k = 0; k < K && cells.nearest[v][k] >= 0; ++k)
+    for (int k = 0; k < detail::SPACING_NEIGHBOURS && cells.nearest[v][k] >= 0; ++k)
       s[v] = std::max(s[v], mean[cells.nearest[v][k]]);
   return s;
+}
+
+std::vector<double>
+localSpacing(const std::vector<Eigen::Vector3d>& points,
+             const VoronoiCells& cells,
+             int threads)
+{
+  return localSpacing(cells, meanSpacing(points, cells, threads), threads);
 }
 
 HalfDisk

@@ -25,8 +25,6 @@ namespace {
 
 constexpr int NEAREST = VoronoiCells::NEAREST;
 constexpr std::size_t TWO_RING = std::size_t(NEAREST) * (NEAREST + 1);
-/** Neighbours of the local spacing, as in localSpacing(). */
-constexpr int SPACING_NEIGHBOURS = 6;
 /** Neighbourhood of the smoothing: CGAL's default for jet fitting. */
 constexpr int SMOOTHING_NEIGHBOURS = 24;
 /** Of each neighbour's nearest Delaunay neighbours, the nearest this many count
@@ -499,23 +497,35 @@ private:
   std::array<std::pair<double, int>, TWO_RING> ring_;
 };
 
-/** The number of p's nearest neighbours within three local spacings (the mean
- * distance to the 6 nearest, meanNeighbourDistance(), written to \a spacing): the
- * Delaunay neighbours of a surface sample include long edges across the inside or
- * the outside, which are not the surface's. */
+/** The number of p's nearest neighbours within three of its \a spacing (the mean
+ * distance to the 6 nearest, meanNeighbourDistance()): the Delaunay neighbours of
+ * a surface sample include long edges across the inside or the outside, which are
+ * not the surface's. */
 int
 nearNeighbours(const std::vector<Eigen::Vector3d>& points,
                const std::array<int, NEAREST>& list,
                int p,
-               double* spacing)
+               double spacing)
 {
   const int c = count(list);
-  *spacing = detail::meanNeighbourDistance(points, list, p, SPACING_NEIGHBOURS);
-  const double reach2 = 9.0 * *spacing * *spacing;
+  const double reach2 = 9.0 * spacing * spacing;
   int k = 0;
   while (k < c && (points[list[k]] - points[p]).squaredNorm() <= reach2)
     ++k;
   return k;
+}
+
+/** The same, with p's spacing from its list. */
+int
+nearNeighbours(const std::vector<Eigen::Vector3d>& points,
+               const std::array<int, NEAREST>& list,
+               int p)
+{
+  return nearNeighbours(
+      points,
+      list,
+      p,
+      detail::meanNeighbourDistance(points, list, p, detail::SPACING_NEIGHBOURS));
 }
 
 /** The noise level of a point from the jet of it and its near neighbours: against
@@ -537,17 +547,17 @@ struct Neighbourhoods {
   std::vector<float> spacing;
 };
 
-/** Fill in p's entry of \a hoods from its neighbour list. */
+/** Fill in p's entry of \a hoods from its neighbour list and its \a spacing
+ * (meanNeighbourDistance() over the list). */
 void
 describe(const std::vector<Eigen::Vector3d>& points,
          const std::array<int, NEAREST>& list,
          int p,
+         double spacing,
          Neighbourhoods& hoods)
 {
-  double mean = 0.0;
-  const int k = nearNeighbours(points, list, p, &mean);
-  hoods.spacing[p] = static_cast<float>(mean);
-  hoods.near[p] = static_cast<std::uint8_t>(k);
+  hoods.spacing[p] = static_cast<float>(spacing);
+  hoods.near[p] = static_cast<std::uint8_t>(nearNeighbours(points, list, p, spacing));
 }
 
 /** A second sheet closer than the spacing (two bodies touching, the sparser of two
@@ -904,16 +914,26 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, NEAREST>>& nearest,
              int threads,
              const std::vector<std::uint8_t>& counted,
-             bool not_noise)
+             bool not_noise,
+             const std::vector<double>& mean_spacing)
 {
   const auto n = static_cast<std::ptrdiff_t>(points.size());
   NoiseAnalysis out;
   out.level.assign(n, 0.0f);
   out.outlier.assign(n, 0);
   Neighbourhoods hoods(n);
+  const bool known = mean_spacing.size() == points.size();
 #pragma omp parallel for num_threads(threads) schedule(static, 4096)
-  for (std::ptrdiff_t p = 0; p < n; ++p)
-    describe(points, nearest[p], static_cast<int>(p), hoods);
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    const int v = static_cast<int>(p);
+    describe(points,
+             nearest[p],
+             v,
+             known ? mean_spacing[p]
+                   : detail::meanNeighbourDistance(
+                         points, nearest[p], v, detail::SPACING_NEIGHBOURS),
+             hoods);
+  }
   // Each point's level and its first verdict from one reading of its neighbours
   // (the verdict needs their spacings, all described first).
   std::vector<Verdict> verdicts(n, Verdict::SURFACE);
@@ -977,7 +997,12 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
       const auto last = std::remove_if(
           list.begin(), list.end(), [&](int q) { return q < 0 || out.outlier[q]; });
       std::fill(last, list.end(), -1);
-      describe(points, list, static_cast<int>(p), hoods);
+      describe(points,
+               list,
+               static_cast<int>(p),
+               detail::meanNeighbourDistance(
+                   points, list, static_cast<int>(p), detail::SPACING_NEIGHBOURS),
+               hoods);
       dirty[p] = 1;
     }
     // Then the points whose near neighbours' spacing changed.
@@ -1042,8 +1067,7 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
       if (q >= 0 && (outlier.empty() || !outlier[q]))
         list[c++] = q;
     std::fill(list.begin() + c, list.end(), -1);
-    double spacing = 0.0;
-    const int k = nearNeighbours(points, list, p, &spacing);
+    const int k = nearNeighbours(points, list, p);
     if (k >= 3)
       level[i] = static_cast<float>(
           noiseLevel(Jet(points.data(), points[p], list.data(), k, true)));

@@ -334,7 +334,8 @@ struct Undersampling {
   double ratio = 0.0;
 };
 
-/** Stage 3 on a triangulation and its first Voronoi pass: the local spacing and the
+/** Stage 3 on a triangulation and its first Voronoi pass: the local spacing (from
+ * \a mean_spacing where the noise handling has it, meanSpacing()) and the
  * half-disk test, which read the nearest neighbours, then the second Voronoi pass
  * (the co-cones, into \a cells), whose peak memory then does not hold the neighbour
  * lists, then the flatness test. Its time goes to \a timings. */
@@ -345,6 +346,7 @@ detectUndersampling(Triangulation& dt,
                     Stages stages,
                     const std::vector<std::uint8_t>& counted,
                     int threads,
+                    std::vector<double> mean_spacing,
                     Timings& timings)
 {
   detail::Stopwatch clock;
@@ -352,7 +354,10 @@ detectUndersampling(Triangulation& dt,
   const bool detect = parameters.boundary_detection;
   const bool half_disk = detect && parameters.gap_angle > 0.0;
   if (detect && (parameters.spacing_factor > 0.0 || half_disk))
-    out.spacing = localSpacing(dt.points, cells, threads);
+    out.spacing = mean_spacing.size() == dt.points.size()
+                      ? localSpacing(cells, mean_spacing, threads)
+                      : localSpacing(dt.points, cells, threads);
+  std::vector<double>().swap(mean_spacing); // before the second pass's peak
   HalfDisk test;
   if (half_disk)
     test = halfDiskTest(dt.points,
@@ -489,20 +494,24 @@ retriangulate(std::vector<Eigen::Vector3d> positions,
  * runStages()) and the stages include the reconstruction, \a dt and \a cells are
  * those of the given points and the smoothed points' sample is returned beside
  * them; null otherwise (without the reconstruction the given points stay). Sets
- * result.error if too few points are left. */
+ * result.error if too few points are left. \a mean_spacing gets the vertices' mean
+ * spacings (meanSpacing()), which stage 3 reads too, while \a dt stays. */
 std::unique_ptr<Sample>
 handleNoise(Triangulation& dt,
             VoronoiCells& cells,
             const Parameters& parameters,
             Stages stages,
             Result& result,
-            int threads)
+            int threads,
+            std::vector<double>& mean_spacing)
 {
   if (cells.nearest.size() != dt.points.size())
     return nullptr; // no neighbour lists (coplanar points): nothing to read
   const std::vector<std::uint8_t> counted =
       countedVertices(parameters, result.vertex_of_input, result.vertices);
-  NoiseAnalysis noise = analyzeNoise(dt.points, cells.nearest, threads, counted);
+  mean_spacing = meanSpacing(dt.points, cells, threads);
+  NoiseAnalysis noise =
+      analyzeNoise(dt.points, cells.nearest, threads, counted, false, mean_spacing);
   result.noise_level = noise.cloud_level;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   result.point_noise.assign(result.vertex_of_input.size(), nan);
@@ -546,7 +555,8 @@ handleNoise(Triangulation& dt,
   // runs again rather than keep its state for this.
   if (noise.cloud_level > parameters.noise_threshold && !result.smoothed &&
       !undecided && noise.outliers > 0)
-    noise = analyzeNoise(dt.points, cells.nearest, threads, counted, true);
+    noise =
+        analyzeNoise(dt.points, cells.nearest, threads, counted, true, mean_spacing);
   if (!result.smoothed && !undecided && noise.outliers == 0)
     return nullptr; // a clean cloud: the triangulation stands
 
@@ -563,6 +573,7 @@ handleNoise(Triangulation& dt,
                          error);
   };
   const auto keep = [&](Sample&& sample) {
+    std::vector<double>().swap(mean_spacing); // the given points' spacings
     dt = std::move(sample.dt);
     cells = std::move(sample.cells);
     result.vertex_of_input = std::move(sample.vertex_of_input);
@@ -599,6 +610,7 @@ completeStages(Triangulation& dt,
                Stages stages,
                const std::vector<int>& ids,
                int threads,
+               std::vector<double> mean_spacing,
                Result& result)
 {
   detail::Stopwatch clock;
@@ -612,6 +624,7 @@ completeStages(Triangulation& dt,
       stages,
       countedVertices(parameters, result.vertex_of_input, result.vertices),
       threads,
+      std::move(mean_spacing),
       result.timings);
   clock.lap();
   result.boundary = std::move(undersampling.boundary);
@@ -709,14 +722,17 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   VoronoiCells cells = computePoles(dt, parameters.cocone_angle, parameters.threads);
   result.timings.voronoi = clock.lap();
   std::unique_ptr<Sample> smoothed;
+  std::vector<double> mean_spacing; // the noise handling's, for stage 3
   if (parameters.noise_handling) {
-    smoothed = handleNoise(dt, cells, parameters, stages, result, threads);
+    smoothed =
+        handleNoise(dt, cells, parameters, stages, result, threads, mean_spacing);
     if (!result.error.empty())
       return result;
   }
   result.timings.noise = clock.lap();
   if (!smoothed) {
-    completeStages(dt, cells, parameters, stages, ids, threads, result);
+    completeStages(
+        dt, cells, parameters, stages, ids, threads, std::move(mean_spacing), result);
     return result;
   }
 
@@ -745,13 +761,14 @@ runStages(std::vector<Eigen::Vector3d>&& points,
   double given_ms = 0.0, smoothed_ms = 0.0;
   const auto given_scale = [&] {
     detail::Stopwatch watch;
-    completeStages(dt, cells, shared, stages, ids, share, result);
+    completeStages(
+        dt, cells, shared, stages, ids, share, std::move(mean_spacing), result);
     given_ms = watch.lap();
   };
   const auto smoothed_scale = [&] {
     detail::Stopwatch watch;
     completeStages(
-        smoothed->dt, smoothed->cells, shared, stages, ids, share, alternative);
+        smoothed->dt, smoothed->cells, shared, stages, ids, share, {}, alternative);
     smoothed_ms = watch.lap();
   };
   detail::forEachTask(2, threads >= 2 ? 2 : 1, [&](std::size_t scale) {

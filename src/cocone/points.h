@@ -32,6 +32,9 @@ isFinite(const Eigen::Vector3d& p)
  * is assumed to change by less than this within a point's neighbourhood. */
 constexpr double FAR_NEIGHBOUR = 10.0;
 
+/** Nearest neighbours whose mean distance is a point's spacing (meanSpacing()). */
+constexpr int SPACING_NEIGHBOURS = 6;
+
 /** Mean distance from \a p to its nearest Delaunay neighbours \a list (nearest
  * first, -1 after the last), the first \a k of them, leaving out those more than
  * FAR_NEIGHBOUR times as far as their median: an edge across a hole or along the convex

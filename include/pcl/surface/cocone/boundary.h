@@ -43,6 +43,29 @@ localSpacing(const std::vector<Eigen::Vector3d>& points,
              const VoronoiCells& cells,
              int threads = 1);
 
+/** \brief The local spacing (see localSpacing()) from the mean distances of the
+ * vertices to their neighbours (meanSpacing()), where a stage before has them.
+ * \param[in] cells the Voronoi pass (its nearest neighbour lists)
+ * \param[in] mean per vertex its mean distance (meanSpacing())
+ * \param[in] threads threads to compute with (the spacings do not depend on them)
+ */
+std::vector<double>
+localSpacing(const VoronoiCells& cells,
+             const std::vector<double>& mean,
+             int threads = 1);
+
+/** \brief Per vertex the mean distance of p to its 6 nearest Delaunay neighbours but
+ * those more than 10 times as far as their median: what localSpacing() maximises,
+ * and what the noise analysis reads its neighbourhoods by (see analyzeNoise()).
+ * \param[in] points the Delaunay vertices
+ * \param[in] cells the Voronoi pass (its nearest neighbour lists)
+ * \param[in] threads threads to compute with (the distances do not depend on them)
+ */
+std::vector<double>
+meanSpacing(const std::vector<Eigen::Vector3d>& points,
+            const VoronoiCells& cells,
+            int threads = 1);
+
 /** \brief Outcome of the half-disk test (see halfDiskTest()). */
 struct HalfDisk {
   /** Per vertex: the largest angle between consecutive nearby neighbours seen along

@@ -66,13 +66,16 @@ struct NoiseAnalysis {
  * \param[in] not_noise the level is known not to be noise (the smoothing would not
  *            take it out): the samples of a sheet of their own are kept whatever
  *            the level
+ * \param[in] mean_spacing per vertex its mean distance to its nearest neighbours
+ *            (meanSpacing()), where the caller has it; empty: computed here
  */
 NoiseAnalysis
 analyzeNoise(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, VoronoiCells::NEAREST>>& nearest,
              int threads = 1,
              const std::vector<std::uint8_t>& counted = {},
-             bool not_noise = false);
+             bool not_noise = false,
+             const std::vector<double>& mean_spacing = {});
 
 /** \brief The noise level of the cloud (NoiseAnalysis::cloud_level) read again on
  * other positions of the same points, with the same neighbours, on one point in 4:
