@@ -521,6 +521,9 @@ handleNoise(Triangulation& dt,
   std::vector<Eigen::Vector3d> smoothed;
   bool undecided = false;
   if (noise.cloud_level > parameters.noise_threshold) {
+    // Not held through the smoothing's peak (the stages after read them again if
+    // the given points' triangulation stands).
+    std::vector<double>().swap(mean_spacing);
     smoothed = smoothPoints(dt.points,
                             cells.nearest,
                             noise.outlier,
@@ -559,6 +562,10 @@ handleNoise(Triangulation& dt,
         analyzeNoise(dt.points, cells.nearest, threads, counted, true, mean_spacing);
   if (!result.smoothed && !undecided && noise.outliers == 0)
     return nullptr; // a clean cloud: the triangulation stands
+  // The given points' triangulation goes below, unless it stands beside the
+  // smoothed points' sample: its spacings go before the new one's peak.
+  if (!undecided || noise.outliers > 0)
+    std::vector<double>().swap(mean_spacing);
 
   const Eigen::Vector3d offset = dt.offset;
   const auto resample = [&](std::vector<Eigen::Vector3d>&& positions,
@@ -573,7 +580,6 @@ handleNoise(Triangulation& dt,
                          error);
   };
   const auto keep = [&](Sample&& sample) {
-    std::vector<double>().swap(mean_spacing); // the given points' spacings
     dt = std::move(sample.dt);
     cells = std::move(sample.cells);
     result.vertex_of_input = std::move(sample.vertex_of_input);
