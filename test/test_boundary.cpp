@@ -131,6 +131,9 @@ TEST(DetectBoundary, SameLabelsWithSeveralThreads)
   EXPECT_LT(count(alone.interior), static_cast<long>(dt.points.size())); // a border
   for (const int threads : {2, 3}) {
     EXPECT_EQ(localSpacing(dt.points, cells, threads), spacing) << threads;
+    EXPECT_EQ(localSpacing(cells, meanSpacing(dt.points, cells, threads), threads),
+              spacing)
+        << threads;
     const BoundaryLabels l = detectBoundary(cells, parameters, spacing, threads);
     EXPECT_EQ(l.ratio_ok, alone.ratio_ok) << threads;
     EXPECT_EQ(l.flat, alone.flat) << threads;

@@ -6,6 +6,7 @@
  * smoothing of noisy clouds, outliers set aside, and clean clouds left as they are.
  */
 
+#include <pcl/surface/cocone/boundary.h>
 #include <pcl/surface/cocone/mesh_checks.h>
 #include <pcl/surface/cocone/noise.h>
 #include <pcl/surface/cocone/pipeline.h>
@@ -508,6 +509,35 @@ TEST(Noise, FlyingPixels)
   ASSERT_GT(outliers, 0u);
   EXPECT_GE(double(found), 0.9 * double(outliers));
   EXPECT_EQ(false_outliers, 0u);
+}
+
+TEST(Noise, GivenMeanSpacingsReadAsComputed)
+{
+  // The pipeline hands the analysis the mean spacings stage 3 reads too
+  // (meanSpacing()): the levels and the outliers, over every round of the search,
+  // are those the analysis finds computing them itself.
+  const Sample s = cocone_test::withOutliers(
+      cocone_test::torus(options(10000, 0.3, 1.0, false)), 0.01, 3.0, 5);
+  const pcl::cocone::Triangulation dt =
+      pcl::cocone::triangulate(pcl::cocone::makeUniquePoints(s.points).points);
+  const pcl::cocone::VoronoiCells cells =
+      pcl::cocone::computePoles(dt, Parameters().cocone_angle);
+  ASSERT_EQ(cells.nearest.size(), dt.points.size());
+  const std::vector<double> mean = pcl::cocone::meanSpacing(dt.points, cells, 2);
+  const pcl::cocone::NoiseAnalysis own =
+      pcl::cocone::analyzeNoise(dt.points, cells.nearest);
+  const pcl::cocone::NoiseAnalysis given =
+      pcl::cocone::analyzeNoise(dt.points, cells.nearest, 2, {}, false, mean);
+  std::printf(
+      "[ measured ] %zu outliers, cloud level %.3f\n", own.outliers, own.cloud_level);
+  EXPECT_GT(own.outliers, 50u); // the search has rounds to run
+  EXPECT_EQ(given.level, own.level);
+  EXPECT_EQ(given.outlier, own.outlier);
+  EXPECT_EQ(given.cloud_level, own.cloud_level);
+  // Means of another size are not read.
+  const pcl::cocone::NoiseAnalysis other = pcl::cocone::analyzeNoise(
+      dt.points, cells.nearest, 1, {}, false, std::vector<double>(3, 0.0));
+  EXPECT_EQ(other.outlier, own.outlier);
 }
 
 TEST(Noise, ScatteredOutliers)
