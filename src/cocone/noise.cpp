@@ -525,17 +525,14 @@ nearNeighbours(const std::vector<Eigen::Vector3d>& points,
   return k;
 }
 
-/** The same, with p's spacing from its list. */
-int
-nearNeighbours(const std::vector<Eigen::Vector3d>& points,
-               const std::array<int, NEAREST>& list,
-               int p)
+/** p's spacing over its neighbour \a list: the mean distance to the nearest 6
+ * (meanNeighbourDistance(), as meanSpacing()). */
+double
+spacingOf(const std::vector<Eigen::Vector3d>& points,
+          const std::array<int, NEAREST>& list,
+          int p)
 {
-  return nearNeighbours(
-      points,
-      list,
-      p,
-      detail::meanNeighbourDistance(points, list, p, detail::SPACING_NEIGHBOURS));
+  return detail::meanNeighbourDistance(points, list, p, detail::SPACING_NEIGHBOURS);
 }
 
 /** The noise level of a point from the jet of it and its near neighbours: against
@@ -558,7 +555,7 @@ struct Neighbourhoods {
 };
 
 /** Fill in p's entry of \a hoods from its neighbour list and its \a spacing
- * (meanNeighbourDistance() over the list). */
+ * (spacingOf()). */
 void
 describe(const std::vector<Eigen::Vector3d>& points,
          const std::array<int, NEAREST>& list,
@@ -939,9 +936,7 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
     describe(points,
              nearest[p],
              v,
-             known ? mean_spacing[p]
-                   : detail::meanNeighbourDistance(
-                         points, nearest[p], v, detail::SPACING_NEIGHBOURS),
+             known ? mean_spacing[p] : spacingOf(points, nearest[p], v),
              hoods);
   }
   // Each point's level and its first verdict from one reading of its neighbours
@@ -1007,12 +1002,8 @@ analyzeNoise(const std::vector<Eigen::Vector3d>& points,
       const auto last = std::remove_if(
           list.begin(), list.end(), [&](int q) { return q < 0 || out.outlier[q]; });
       std::fill(last, list.end(), -1);
-      describe(points,
-               list,
-               static_cast<int>(p),
-               detail::meanNeighbourDistance(
-                   points, list, static_cast<int>(p), detail::SPACING_NEIGHBOURS),
-               hoods);
+      const int v = static_cast<int>(p);
+      describe(points, list, v, spacingOf(points, list, v), hoods);
       dirty[p] = 1;
     }
     // Then the points whose near neighbours' spacing changed.
@@ -1077,7 +1068,7 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
       if (q >= 0 && (outlier.empty() || !outlier[q]))
         list[c++] = q;
     std::fill(list.begin() + c, list.end(), -1);
-    const int k = nearNeighbours(points, list, p);
+    const int k = nearNeighbours(points, list, p, spacingOf(points, list, p));
     if (k >= 3)
       level[i] = static_cast<float>(
           noiseLevel(Jet(points.data(), points[p], list.data(), k, true)));
