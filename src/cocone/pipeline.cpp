@@ -558,8 +558,7 @@ handleNoise(Triangulation& dt,
   // runs again rather than keep its state for this.
   if (noise.cloud_level > parameters.noise_threshold && !result.smoothed &&
       !undecided && noise.outliers > 0)
-    noise =
-        analyzeNoise(dt.points, cells.nearest, threads, counted, true, mean_spacing);
+    noise = analyzeNoise(dt.points, cells.nearest, threads, counted, true);
   if (!result.smoothed && !undecided && noise.outliers == 0)
     return nullptr; // a clean cloud: the triangulation stands
   // The given points' triangulation goes below, unless it stands beside the
