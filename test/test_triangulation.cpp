@@ -68,6 +68,36 @@ TEST(UniquePoints, SameWithAnyThreadCount)
   }
 }
 
+TEST(UniquePoints, SmallAndLargeCloudsNumberedAlike)
+{
+  // A small cloud is sorted by comparison, a large one by radix: the same order
+  // along the Morton curve. The small cloud here is part of the large one with the
+  // same bounding box (its two corners), so its vertices must come in the order
+  // they have among the large cloud's; some share a Morton code.
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> large{{-1, -1, -1}, {1, 1, 1}};
+  while (large.size() < 40000) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    large.push_back(p);
+    if (large.size() % 50 == 0) // a neighbour within the same Morton cell
+      large.push_back(p + Eigen::Vector3d(0.0, 1e-9, 0.0));
+  }
+  std::vector<Eigen::Vector3d> small;
+  for (std::size_t i = 0; i < large.size(); i += 4)
+    small.push_back(large[i]);
+  small.push_back(large[1]);
+  ASSERT_LT(small.size(), 16384u); // the comparison sort
+  const UniquePoints all = makeUniquePoints(large);
+  const UniquePoints part = makeUniquePoints(small);
+  ASSERT_EQ(part.points.size(), small.size());
+  std::vector<int> rank(part.points.size());
+  for (std::size_t i = 0; i + 1 < small.size(); ++i)
+    rank[part.vertex_of_input[i]] = all.vertex_of_input[4 * i];
+  rank[part.vertex_of_input.back()] = all.vertex_of_input[1];
+  EXPECT_TRUE(std::is_sorted(rank.begin(), rank.end()));
+}
+
 TEST(Triangulate, DimensionOfDegenerateInput)
 {
   EXPECT_EQ(triangulate({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}}).dimension, 1);
