@@ -368,8 +368,11 @@ TEST(Noise, NoisyCoarseTubeIsSmoothedWhereItMeshesBetter)
   // smoothing moves the points partly as noise (kurtosis 2.2), partly alike (the
   // tube drawn towards its axis), so the displacements do not tell. Both scales are
   // reconstructed, and the smoothed one resolves more of the surface: measured, 0,
-  // 1, 0, 0 loops where the given points left 2, 3, 5, 2 (the mesh closed with
-  // Euler 0 on seeds 1 and 4; on seed 3 the tube is pinched, Euler 2).
+  // 2, 0, 0 loops where the given points left 2, 3, 5, 2 (the mesh closed with
+  // Euler 0 on seeds 1 and 4; on seed 3 the tube is pinched, Euler 2). Seed 2's
+  // second loop is the outline of a flake off the tube, one sample and its ring of
+  // seven: kept open since a piece's outline is a true border (capped before, a
+  // closed pillow of no volume).
   std::size_t loops = 0;
   for (const std::uint64_t seed : {1u, 2u, 3u, 4u}) {
     SampleOptions o = options(8000, 0.5, 1.0, true);
@@ -384,7 +387,7 @@ TEST(Noise, NoisyCoarseTubeIsSmoothedWhereItMeshesBetter)
                 int(r.smoothed));
     EXPECT_TRUE(r.smoothed);
     EXPECT_TRUE(m.topology.manifold()) << m.str();
-    EXPECT_LE(m.loops, 1u) << m.str();
+    EXPECT_LE(m.loops, 2u) << m.str();
     EXPECT_LT(m.max_distance, 2.5) << m.str(); // within the noise, 5 sigma
     loops += m.loops;
   }

@@ -5,6 +5,7 @@
  * Reconstruction (stages 1-7) on surfaces with known topology.
  */
 
+#include <pcl/surface/cocone/border_classification.h>
 #include <pcl/surface/cocone/handle_removal.h>
 #include <pcl/surface/cocone/hole_filling.h>
 #include <pcl/surface/cocone/hole_reopening.h>
@@ -1772,6 +1773,75 @@ TEST(HoleFilling, TrueHolesFourSpacingsAcrossStayOpen)
     EXPECT_EQ(m.loops, 6u) << m.str();
     EXPECT_EQ(m.topology.euler, 2 - 6);
   }
+}
+
+TEST(HoleFilling, OutlineOfAPieceIsATrueBorder)
+{
+  // A strip three samples wide, bent along its length (a one-view scan's ear cut
+  // off from the head: PCL's 397-point bunny came out with its ear capped into a
+  // closed pillow), beside a sheet with a hole of one missing sample. The strip's
+  // outline is as narrow as the hole (2.4 of its triangles: within the hole width
+  // of 2.5), and the strip's own middle row lies over it: but the loop runs round
+  // its whole piece, the piece's outline, not a hole in it, and stays open.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<pcl::cocone::Triangle> mesh;
+  const auto grid = [&](int rows, int columns, const Eigen::Vector3d& at, double bend) {
+    const int first = static_cast<int>(points.size());
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < columns; ++c) {
+        const double x = c + 0.5 * (r % 2), u = x - 0.5 * columns;
+        points.push_back(at + Eigen::Vector3d(x, 0.866 * r, bend * u * u));
+      }
+    const auto id = [&](int r, int c) { return first + r * columns + c; };
+    for (int r = 0; r + 1 < rows; ++r)
+      for (int c = 0; c + 1 < columns; ++c)
+        if (r % 2 == 0) {
+          mesh.push_back({id(r, c), id(r, c + 1), id(r + 1, c)});
+          mesh.push_back({id(r, c + 1), id(r + 1, c + 1), id(r + 1, c)});
+        }
+        else {
+          mesh.push_back({id(r, c), id(r, c + 1), id(r + 1, c + 1)});
+          mesh.push_back({id(r, c), id(r + 1, c + 1), id(r + 1, c)});
+        }
+    return id;
+  };
+  const auto strip = grid(3, 12, Eigen::Vector3d(0, 0, 20), 0.05);
+  const auto sheet = grid(12, 12, Eigen::Vector3d(0, 0, 0), 0.0);
+  // The hole: the six triangles round one sample of the sheet (row 5, column 5).
+  const int hole = sheet(5, 5);
+  mesh.erase(std::remove_if(mesh.begin(),
+                            mesh.end(),
+                            [&](const pcl::cocone::Triangle& t) {
+                              return t[0] == hole || t[1] == hole || t[2] == hole;
+                            }),
+             mesh.end());
+  std::vector<pcl::cocone::CoconeTriangle> cocone;
+  for (auto t : mesh) {
+    std::sort(t.begin(), t.end());
+    cocone.push_back({t, 7});
+  }
+  std::sort(cocone.begin(), cocone.end(), [](const auto& a, const auto& b) {
+    return a.v < b.v;
+  });
+  const pcl::cocone::EdgeIncidences incidences(mesh);
+  const auto loops = pcl::cocone::boundaryLoops(incidences, points.size());
+  ASSERT_EQ(loops.size(), 3u); // the strip's outline, the sheet's, the hole
+  const auto border =
+      pcl::cocone::classifyBorderLoops(points, mesh, loops, cocone, 2.5, 1000);
+  std::size_t checked = 0;
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    SCOPED_TRACE(testing::Message() << "loop of " << loops[l].size() << " edges");
+    if (loops[l][0] <= strip(2, 11)) {
+      EXPECT_EQ(border[l], 1); // the strip's outline
+      ++checked;
+    }
+    else if (std::find(loops[l].begin(), loops[l].end(), sheet(5, 4)) !=
+             loops[l].end()) {
+      EXPECT_EQ(border[l], 0); // the hole
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 2u);
 }
 
 namespace {

@@ -9,6 +9,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include "cocone_neighbours.h"
+#include "disjoint_sets.h"
 #include "loop_plane.h"
 #include "points.h"
 
@@ -41,6 +42,91 @@ widestEmptyDisk(const detail::LoopPlane& hole,
       widest = std::max(widest, CGAL::squared_distance(c, face->vertex(0)->point()));
   }
   return 2.0 * std::sqrt(widest);
+}
+
+/** A loop that this share of its piece's other vertices lie over (within its
+ * radius, near its plane, inside it: LoopPlane::contains()) runs round the whole
+ * piece: the piece's outline, not a hole in it, which has the surface going on all
+ * round. Capped, it would lay a second sheet over the piece, a closed pillow of no
+ * volume: measured on PCL's 397-point bunny (one view), whose ear, cut off from
+ * the head, came out so, and on the merged Stanford scans, whose flakes off the
+ * surface (8 to 41 vertices) did. */
+constexpr double OUTLINE_SHARE = 0.9;
+
+/** The pieces (connected components) of the mesh: per vertex its piece, -1 for
+ * a vertex no triangle uses, and per piece its vertices and bounding box. */
+struct Pieces {
+  std::vector<int> of;
+  std::vector<std::vector<int>> vertices;
+  std::vector<Eigen::Vector3d> low, high;
+};
+
+Pieces
+meshPieces(const std::vector<Eigen::Vector3d>& points,
+           const std::vector<Triangle>& triangles)
+{
+  detail::DisjointSets sets(points.size());
+  std::vector<std::uint8_t> used(points.size(), 0);
+  for (const auto& t : triangles) {
+    sets.unite(t[0], t[1]);
+    sets.unite(t[0], t[2]);
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  Pieces out;
+  out.of.assign(points.size(), -1);
+  std::vector<int> piece_of_root(points.size(), -1);
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    if (!used[v])
+      continue;
+    int& piece = piece_of_root[sets.find(static_cast<int>(v))];
+    if (piece < 0) {
+      piece = static_cast<int>(out.vertices.size());
+      out.vertices.emplace_back();
+      out.low.push_back(points[v]);
+      out.high.push_back(points[v]);
+    }
+    out.of[v] = piece;
+    out.vertices[piece].push_back(static_cast<int>(v));
+    out.low[piece] = out.low[piece].cwiseMin(points[v]);
+    out.high[piece] = out.high[piece].cwiseMax(points[v]);
+  }
+  return out;
+}
+
+/** Whether \a loop (projected as \a hole) is the outline of its piece: a strip or
+ * flake a few samples across, with no more vertices inside it than on the loop
+ * (which the width alone reads as narrow as a hole), whose other vertices lie over
+ * the loop (OUTLINE_SHARE of them). A wider piece can lie inside a loop of its own
+ * that must close: the slit round the rim of a plate thinner than the spacing,
+ * both of whose sheets lie over it (without the bound the generated sweep's clean
+ * thin plates kept 40 loops beyond the truth rather than 19). A closed surface's
+ * hole is none: the rest of the surface leaves the hole's plane. */
+bool
+isOutline(const std::vector<Eigen::Vector3d>& points,
+          const std::vector<int>& loop,
+          const detail::LoopPlane& hole,
+          const Pieces& pieces)
+{
+  const int piece = pieces.of[loop.front()];
+  if (piece < 0)
+    return false;
+  // A piece that lies over its loop lies within the loop's radius of its centre,
+  // its bounding box within twice the loop's diameter: the large pieces with small
+  // holes are passed over without a look at their vertices.
+  const Eigen::Vector3d reach = pieces.high[piece] - pieces.low[piece];
+  if (reach.norm() > 4.0 * hole.radius)
+    return false;
+  const auto& vertices = pieces.vertices[piece];
+  const std::size_t others = vertices.size() - loop.size();
+  if (others > loop.size())
+    return false;
+  std::size_t outside = 0;
+  for (const int v : vertices)
+    if (!hole.contains(points[v]) &&
+        std::find(loop.begin(), loop.end(), v) == loop.end() &&
+        ++outside > (1.0 - OUTLINE_SHARE) * static_cast<double>(others))
+      return false;
+  return others > 0;
 }
 
 } // namespace
@@ -81,6 +167,7 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
       }
     }
   }
+  const Pieces pieces = meshPieces(points, triangles);
   // The co-cone triangles' corners at each point, to find the points in each hole.
   const detail::CoconeNeighbours around = detail::coconeNeighbours(
       cocone_triangles, points.size(), [](int) { return true; });
@@ -92,6 +179,9 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     if (loop.size() < 3 || loop.size() > max_edges || radii.empty())
       continue;
     const detail::LoopPlane hole = detail::projectLoop(points, loop);
+    if (isOutline(points, loop, hole, pieces))
+      continue; // a true border
+
     // The points in the hole: reached from the loop through co-cone triangles,
     // each projecting into it.
     const int stamp = static_cast<int>(l);

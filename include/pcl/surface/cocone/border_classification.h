@@ -42,6 +42,11 @@ namespace cocone {
  * sqrt(m + 1) each) and was closed; on the closed meshes and the synthetic
  * surfaces no loop's class changed.
  *
+ * A loop round the whole of its piece of the mesh (a strip or flake a few samples
+ * across, whose other vertices lie over the loop) is a true border whatever its
+ * width: the outline of a sheet cut off from the rest (an ear of a single view),
+ * which a patch would double into a closed pillow of no volume.
+ *
  * Assumes the sampling round a hole is locally even: a flat face that a mesh's
  * vertices sample only along its outline, wider than \a max_width of its rim's
  * triangles, reads as a true border, and so does a hole that noise tears where
