@@ -423,6 +423,39 @@ TEST(Noise, HeavyTailedDisplacementsLetTheMeshesChooseTheScale)
   }
 }
 
+TEST(Noise, BothScalesWithRefinedPatches)
+{
+  // Where both scales are reconstructed, each with its filled holes refined, the
+  // meshes are compared with the vertices the refinement added in them: the
+  // comparison once sized its arrays by the sample's vertices alone and wrote past
+  // them (the merged Stanford scans with -refine_holes aborted in free(); the
+  // sanitizer build catches the write here).
+  Parameters refine;
+  refine.refine_filled_holes = true;
+  const Sample s = cocone_test::twoTouchingSpheres(options(4000, 0.1, 1.0, true));
+  const Result plain = reconstruct(s.points);
+  const Result r = reconstruct(s.points, refine);
+  // The added vertices follow the sample's (scoreMesh() reads the sample's only).
+  const auto topology = pcl::cocone::analyzeMesh(r.triangles, r.positions.size());
+  std::printf(
+      "[ measured ] %s, refined: %zu holes, %zu vertices added, %zu components, "
+      "Euler %ld, %zu loops\n",
+      s.name.c_str(),
+      r.counts.holes_filled,
+      r.added_vertices,
+      topology.components,
+      static_cast<long>(topology.euler),
+      r.border_loops.size());
+  EXPECT_GT(r.counts.holes_filled, 0u);
+  EXPECT_GT(r.added_vertices, 0u); // the case that wrote past the arrays
+  EXPECT_EQ(r.positions.size(), r.vertices + r.added_vertices);
+  EXPECT_EQ(r.smoothed, plain.smoothed);
+  EXPECT_TRUE(topology.manifold());
+  EXPECT_EQ(topology.components, static_cast<std::size_t>(s.components));
+  EXPECT_EQ(topology.euler, s.euler);
+  EXPECT_TRUE(r.border_loops.empty());
+}
+
 TEST(Noise, CleanCloudUnchanged)
 {
   // Clean samples read no noise and have no outlier: the pipeline gives what it

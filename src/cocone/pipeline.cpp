@@ -687,7 +687,10 @@ unresolvedVertices(const Parameters& parameters, const Result& result)
 {
   const std::vector<std::uint8_t> counted =
       countedVertices(parameters, result.vertex_of_input, result.vertices);
-  std::vector<std::uint8_t> resolved = usedVertices(result.triangles, result.vertices);
+  // The mesh also holds the vertices the refinement of the filled holes added
+  // (Result::positions beyond the sample's), which no input point is.
+  std::vector<std::uint8_t> resolved = usedVertices(
+      result.triangles, std::max(result.vertices, result.positions.size()));
   for (const int v : borderVertices(result.triangles))
     resolved[v] = 0;
   std::size_t count = 0;
