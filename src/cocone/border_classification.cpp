@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace pcl {
 namespace cocone {
@@ -180,7 +179,7 @@ classifyBorderLoops(const std::vector<Eigen::Vector3d>& points,
     if (loop.size() < 3 || loop.size() > max_edges || radii.empty())
       continue;
     const detail::LoopPlane hole = detail::projectLoop(points, loop);
-    if (!std::getenv("NOOUTLINE") && isOutline(points, loop, hole, pieces))
+    if (isOutline(points, loop, hole, pieces))
       continue; // a true border
 
     // The points in the hole: reached from the loop through co-cone triangles,
