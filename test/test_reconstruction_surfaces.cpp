@@ -1792,7 +1792,7 @@ TEST(HoleFilling, OutlineOfAPieceIsATrueBorder)
         const double x = c + 0.5 * (r % 2), u = x - 0.5 * columns;
         points.push_back(at + Eigen::Vector3d(x, 0.866 * r, bend * u * u));
       }
-    const auto id = [&](int r, int c) { return first + r * columns + c; };
+    const auto id = [first, columns](int r, int c) { return first + r * columns + c; };
     for (int r = 0; r + 1 < rows; ++r)
       for (int c = 0; c + 1 < columns; ++c)
         if (r % 2 == 0) {
