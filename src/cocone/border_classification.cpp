@@ -54,10 +54,10 @@ widestEmptyDisk(const detail::LoopPlane& hole,
 constexpr double OUTLINE_SHARE = 0.9;
 
 /** The pieces (connected components) of the mesh: per vertex its piece, -1 for
- * a vertex no triangle uses, and per piece its vertices and bounding box. */
+ * a vertex no triangle uses; per piece its bounding box and its vertices, piece
+ * after piece in one array (those of piece k from first[k] to first[k + 1]). */
 struct Pieces {
-  std::vector<int> of;
-  std::vector<std::vector<int>> vertices;
+  std::vector<int> of, first, vertices;
   std::vector<Eigen::Vector3d> low, high;
 };
 
@@ -65,6 +65,8 @@ Pieces
 meshPieces(const std::vector<Eigen::Vector3d>& points,
            const std::vector<Triangle>& triangles)
 {
+  // Joined through vertices rather than edges (triangleComponents()): the repaired
+  // mesh has one fan per vertex, so the pieces are the same, without the edges.
   detail::DisjointSets sets(points.size());
   std::vector<std::uint8_t> used(points.size(), 0);
   for (const auto& t : triangles) {
@@ -75,21 +77,30 @@ meshPieces(const std::vector<Eigen::Vector3d>& points,
   Pieces out;
   out.of.assign(points.size(), -1);
   std::vector<int> piece_of_root(points.size(), -1);
+  std::vector<int> count;
   for (std::size_t v = 0; v < points.size(); ++v) {
     if (!used[v])
       continue;
     int& piece = piece_of_root[sets.find(static_cast<int>(v))];
     if (piece < 0) {
-      piece = static_cast<int>(out.vertices.size());
-      out.vertices.emplace_back();
+      piece = static_cast<int>(count.size());
+      count.push_back(0);
       out.low.push_back(points[v]);
       out.high.push_back(points[v]);
     }
     out.of[v] = piece;
-    out.vertices[piece].push_back(static_cast<int>(v));
+    ++count[piece];
     out.low[piece] = out.low[piece].cwiseMin(points[v]);
     out.high[piece] = out.high[piece].cwiseMax(points[v]);
   }
+  out.first.assign(count.size() + 1, 0);
+  for (std::size_t k = 0; k < count.size(); ++k)
+    out.first[k + 1] = out.first[k] + count[k];
+  out.vertices.resize(out.first.back());
+  std::vector<int> next(out.first.begin(), out.first.end() - 1);
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (out.of[v] >= 0)
+      out.vertices[next[out.of[v]]++] = static_cast<int>(v);
   return out;
 }
 
@@ -116,14 +127,15 @@ isOutline(const std::vector<Eigen::Vector3d>& points,
   const Eigen::Vector3d reach = pieces.high[piece] - pieces.low[piece];
   if (reach.norm() > 4.0 * hole.radius)
     return false;
-  const auto& vertices = pieces.vertices[piece];
-  const std::size_t others = vertices.size() - loop.size();
+  const auto begin = pieces.vertices.begin() + pieces.first[piece],
+             end = pieces.vertices.begin() + pieces.first[piece + 1];
+  const std::size_t others = static_cast<std::size_t>(end - begin) - loop.size();
   if (others > loop.size())
     return false;
   std::size_t outside = 0;
-  for (const int v : vertices)
-    if (!hole.contains(points[v]) &&
-        std::find(loop.begin(), loop.end(), v) == loop.end() &&
+  for (auto v = begin; v != end; ++v)
+    if (!hole.contains(points[*v]) &&
+        std::find(loop.begin(), loop.end(), *v) == loop.end() &&
         ++outside > (1.0 - OUTLINE_SHARE) * static_cast<double>(others))
       return false;
   return others > 0;
