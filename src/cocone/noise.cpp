@@ -1079,6 +1079,24 @@ cloudNoiseLevel(const std::vector<Eigen::Vector3d>& points,
   return median(level);
 }
 
+double
+medianPoleHeight(const VoronoiCells& cells,
+                 const std::vector<double>& mean_spacing,
+                 const std::vector<std::uint8_t>& outlier,
+                 const std::vector<std::uint8_t>& counted)
+{
+  std::vector<double> height;
+  height.reserve(cells.height_plus.size());
+  for (std::size_t v = 0; v < cells.height_plus.size(); ++v) {
+    if ((!outlier.empty() && outlier[v]) || (!counted.empty() && !counted[v]))
+      continue;
+    const double h = cells.height_plus[v] / mean_spacing[v];
+    if (std::isfinite(h))
+      height.push_back(h);
+  }
+  return median(std::move(height));
+}
+
 std::vector<Eigen::Vector3d>
 smoothPoints(const std::vector<Eigen::Vector3d>& points,
              const std::vector<std::array<int, NEAREST>>& nearest,

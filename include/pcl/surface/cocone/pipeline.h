@@ -82,11 +82,14 @@ struct Parameters {
    * half the level and moved the points as noise would (displacementKurtosis() at
    * least 2.5; a surface too coarse or too creased for the jets, a tube a few
    * samples round or two sheets closer than the spacing, moves alike, below 1.8,
-   * and is left as it is). In between, where noise on a coarse or creased surface
-   * moves the points partly as noise and partly alike, a reconstruction runs on
-   * both and the smoothed points' mesh is kept if it leaves out or has on its
-   * border at most 0.8 of the points that the given points' mesh does (boundary
-   * detection alone keeps the given points). false: the points as given. */
+   * and is left as it is), and lengthened the poles as taking noise out does
+   * (medianPoleHeight() at least 1.6 times the given points'; a clean but unevenly
+   * sampled mesh's vertex set can read as noisy). In between, where noise on a
+   * coarse or creased surface moves the points partly as noise and partly alike, or
+   * the poles stay put, a reconstruction runs on both and the smoothed points' mesh is
+   * kept if it leaves out or has on its border at most 0.8 of the points that the given
+   * points' mesh does (boundary detection alone keeps the given points). false: the
+   * points as given. */
   bool noise_handling = true;
   /** The cloud noise level (about sigma in sample spacings) above which the
    * decisions are taken on smoothed points: where the pipeline without smoothing
