@@ -305,6 +305,19 @@ writeAtomically(const std::string& path, const Write& write, std::string& error)
   return true;
 }
 
+/** \a cloud as the points \a xyz (x, y, z as floats). */
+void
+xyzCloud(const std::vector<Eigen::Vector3d>& xyz, pcl::PCLPointCloud2& cloud)
+{
+  pcl::PointCloud<pcl::PointXYZ> points;
+  for (const Eigen::Vector3d& x : xyz)
+    points.push_back(pcl::PointXYZ(static_cast<float>(x.x()),
+                                   static_cast<float>(x.y()),
+                                   static_cast<float>(x.z())));
+  points.is_dense = false;
+  pcl::toPCLPointCloud2(points, cloud);
+}
+
 /** Read whitespace-separated x y z lines; '#' starts a comment. With \a obj, only
  * the vertex lines ("v x y z") of a Wavefront file count. PCL's OBJ reader crashes on
  * a vertex line with fewer than three numbers, so OBJ files are read here too. */
@@ -315,7 +328,7 @@ readText(const std::string& path,
          bool obj = false)
 {
   std::ifstream in(path);
-  std::vector<float> xyz;
+  std::vector<Eigen::Vector3d> xyz;
   std::string line;
   std::size_t number = 0;
   while (std::getline(in, line)) {
@@ -340,20 +353,103 @@ readText(const std::string& path,
               (obj ? " is not 'v x y z'" : " is not 'x y z'");
       return false;
     }
-    for (const double c : v)
-      xyz.push_back(static_cast<float>(c));
+    xyz.emplace_back(v[0], v[1], v[2]);
   }
   if (xyz.empty()) {
     error = "no points";
     return false;
   }
-  pcl::PointCloud<pcl::PointXYZ> points;
-  for (std::size_t i = 0; i < xyz.size(); i += 3)
-    points.push_back(pcl::PointXYZ(xyz[i], xyz[i + 1], xyz[i + 2]));
-  points.is_dense = false;
-  pcl::toPCLPointCloud2(points, cloud);
+  xyzCloud(xyz, cloud);
   return true;
 }
+
+} // namespace
+
+bool
+readOff(const std::string& path,
+        std::vector<Eigen::Vector3d>& vertices,
+        std::vector<std::array<int, 3>>* faces,
+        std::string& error)
+{
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot read '" + path + "'";
+    return false;
+  }
+  vertices.clear();
+  std::string line;
+  std::size_t number = 0;
+  // The next line that is not blank or a comment, as a stream of its fields.
+  const auto next = [&](std::istringstream& fields) {
+    while (std::getline(in, line)) {
+      ++number;
+      const auto hash = line.find('#');
+      if (hash != std::string::npos)
+        line.resize(hash);
+      if (line.find_first_not_of(" \t\r") != std::string::npos) {
+        fields.clear();
+        fields.str(line);
+        return true;
+      }
+    }
+    return false;
+  };
+  const auto fail = [&](const std::string& why) {
+    error = (number > 0 ? "line " + std::to_string(number) + ": " : "") + why;
+    return false;
+  };
+  std::istringstream fields;
+  std::string header;
+  if (!next(fields) || !(fields >> header))
+    return fail("no OFF header");
+  // [ST][C][N]OFF: texture coordinates, colours and normals follow x y z on a
+  // vertex's line and are skipped (4OFF and nOFF, other dimensions, are refused).
+  const std::size_t off = header.rfind("OFF");
+  const std::string prefix = header.substr(0, off);
+  if (off == std::string::npos || off + 3 != header.size() ||
+      prefix.find_first_not_of("STCN") != std::string::npos)
+    return fail("not a 3D OFF header: '" + header + "'");
+  // The counts (vertices, faces, edges) follow on the header's line or the next.
+  std::vector<std::string> tokens;
+  std::string token;
+  while (fields >> token)
+    tokens.push_back(token);
+  if (!tokens.empty() && tokens[0] == "BINARY")
+    return fail("binary OFF is not read");
+  while (tokens.size() < 2 && next(fields))
+    while (fields >> token)
+      tokens.push_back(token);
+  std::size_t counts[2] = {0, 0};
+  if (tokens.size() < 2 || tokens.size() > 3 || !parseCount(tokens[0], counts[0]) ||
+      !parseCount(tokens[1], counts[1]))
+    return fail("no vertex, face and edge counts");
+  for (std::size_t v = 0; v < counts[0]; ++v) {
+    double x[3];
+    if (!next(fields) || !(fields >> x[0] >> x[1] >> x[2]))
+      return fail("vertex " + std::to_string(v) + " is not 'x y z'");
+    vertices.emplace_back(x[0], x[1], x[2]);
+  }
+  if (!faces)
+    return true;
+  faces->clear();
+  for (std::size_t f = 0; f < counts[1]; ++f) {
+    std::size_t corners = 0;
+    if (!next(fields) || !(fields >> token) || !parseCount(token, corners))
+      return fail("face " + std::to_string(f) + " has no corner count");
+    std::vector<int> face;
+    for (std::size_t c = 0; c < corners; ++c) {
+      std::size_t v = 0;
+      if (!(fields >> token) || !parseCount(token, v) || v >= vertices.size())
+        return fail("face " + std::to_string(f) + " names a missing vertex");
+      face.push_back(static_cast<int>(v));
+    }
+    for (std::size_t k = 2; k < face.size(); ++k)
+      faces->push_back({face[0], face[k - 1], face[k]});
+  }
+  return true;
+}
+
+namespace {
 
 /** The scans a Stanford range-scan configuration lists ("bmesh FILE tx ty tz qx qy
  * qz qw" lines, the files relative to the configuration's directory), each moved
@@ -447,8 +543,8 @@ extension(const std::string& path)
 bool
 isInputFormat(const std::string& ext)
 {
-  return ext == "pcd" || ext == "ply" || ext == "obj" || ext == "xyz" || ext == "txt" ||
-         ext == "pts" || ext == "conf";
+  return ext == "pcd" || ext == "ply" || ext == "obj" || ext == "off" || ext == "xyz" ||
+         ext == "txt" || ext == "pts" || ext == "conf";
 }
 
 bool
@@ -462,8 +558,8 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
 {
   const std::string ext = extension(path);
   if (!isInputFormat(ext)) {
-    error =
-        "unknown input format '" + ext + "' (use .pcd, .ply, .obj, .xyz, .txt, .conf)";
+    error = "unknown input format '" + ext +
+            "' (use .pcd, .ply, .obj, .off, .xyz, .txt, .conf)";
     return false;
   }
   if (!isFile(path)) {
@@ -495,6 +591,16 @@ readCloud(const std::string& path, pcl::PCLPointCloud2& cloud, std::string& erro
         status = pcl::io::loadPLYFile(path, cloud);
       else
         ok = false;
+    }
+    else if (ext == "off") {
+      std::vector<Eigen::Vector3d> vertices;
+      ok = readOff(path, vertices, nullptr, error);
+      if (ok && vertices.empty()) {
+        ok = false;
+        error = "no points";
+      }
+      if (ok)
+        xyzCloud(vertices, cloud);
     }
     else
       ok = readText(path, cloud, error, ext == "obj");

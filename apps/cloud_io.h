@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <set>
@@ -36,7 +37,19 @@ isInputFormat(const std::string& ext);
 bool
 isMeshFormat(const std::string& ext);
 
-/** Read a point cloud (.pcd, .ply, .obj, .xyz/.txt/.pts, or the registered range
+/** Read an Object File Format mesh (.off, as CGAL and Geomview write it): its
+ * vertices, and if \a faces is given its faces as triangles (polygons as fans) over
+ * them, numbered from 0. The header may be OFF, COFF, NOFF or CNOFF (the colours and
+ * normals after x y z are skipped), its counts on its own line or the next; '#'
+ * starts a comment. Binary OFF and higher dimensions are refused. False, and why
+ * in \a error, if the file is not such a mesh or a face names a missing vertex. */
+bool
+readOff(const std::string& path,
+        std::vector<Eigen::Vector3d>& vertices,
+        std::vector<std::array<int, 3>>* faces,
+        std::string& error);
+
+/** Read a point cloud (.pcd, .ply, .obj, .off, .xyz/.txt/.pts, or the registered range
  * scans a Stanford .conf lists, merged); on failure return false and say why in
  * \a error. Only the vertices of a mesh file are read. */
 bool

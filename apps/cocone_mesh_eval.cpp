@@ -11,11 +11,12 @@
  * e.g. cocone_mesh_eval ../shared/data/closed_meshes/bunny.obj
  *        ../shared/data/powercrust_samples/knot.pts:0
  *
- * A Wavefront .obj with faces is a mesh: its vertices (all of them, referenced or
- * not) are the cloud, and its faces the truth: the Euler characteristic V - E + F
- * over the referenced vertices, the components (through shared edges), the boundary
- * edges (none: a closed shape) and the genus (2 components - Euler) / 2. Any other
- * cloud (.pts, .xyz, .ply, .pcd, an .obj without faces) has only the Euler
+ * A Wavefront .obj or an .off (CGAL's example meshes) with faces is a mesh: its
+ * vertices (all of them, referenced or not) are the cloud, and its faces the truth:
+ * the Euler characteristic V - E + F over the referenced vertices, the components
+ * (through shared edges), the boundary edges (none: a closed shape) and the genus
+ * (2 components - Euler) / 2. Any other cloud (.pts, .xyz, .ply, .pcd, an .obj or
+ * .off without faces) has only the Euler
  * characteristic given after the name (FILE:EULER; "?" or none: unknown).
  *
  * Each cloud goes to this library with the default parameters (threads from
@@ -100,7 +101,7 @@ addNoise(std::vector<Eigen::Vector3d>& points, double sigma, unsigned int seed)
 
 /** What is known of the true surface of a cloud. */
 struct Truth {
-  bool mesh = false;            ///< from the faces of an .obj
+  bool mesh = false;            ///< from the faces of an .obj or .off
   bool euler_known = false;     ///< the Euler characteristic is known
   long euler = 0;               ///< V - E + F
   MeshTopology topology;        ///< of the faces (mesh only)
@@ -444,10 +445,13 @@ main(int argc, char** argv)
       status = 1;
       continue;
     }
-    if (cocone_app::extension(path) == "obj") {
+    const std::string ext = cocone_app::extension(path);
+    if (ext == "obj" || ext == "off") {
       std::vector<Triangle> faces;
       std::size_t vertices = 0;
-      if (!readObjFaces(path, faces, vertices, error)) {
+      std::vector<Eigen::Vector3d> off_vertices;
+      if (ext == "obj" ? !readObjFaces(path, faces, vertices, error)
+                       : !cocone_app::readOff(path, off_vertices, &faces, error)) {
         std::fprintf(stderr, "%s: %s\n", path.c_str(), error.c_str());
         status = 1;
         continue;

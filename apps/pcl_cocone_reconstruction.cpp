@@ -67,8 +67,9 @@ printHelp(const char* name)
       "ends and closes the holes the surface goes on across (-no_fill: all open).\n\n");
   print_info("Syntax: %s INPUT OUTPUT [options]\n\n", name);
   print_info(
-      "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .xyz/.txt (x y "
-      "z per line),\n"
+      "  INPUT   .pcd, .ply (a point cloud or a mesh's vertices), .obj, .off, "
+      ".xyz/.txt\n"
+      "          (x y z per line),\n"
       "          .conf (registered range scans, Stanford's format: the scans it lists, "
       "merged)\n"
       "  OUTPUT  .vtk (legacy, what pcl_viewer opens), .ply, .obj, .stl\n\n"
@@ -251,7 +252,8 @@ parseOptions(int argc, char** argv)
   parse_argument(argc, argv, "-screenshot", o.screenshot_file);
 
   if (!cocone_app::isInputFormat(cocone_app::extension(o.input)))
-    fail("unknown input format '" + o.input + "' (use .pcd, .ply, .obj, .xyz or .txt)");
+    fail("unknown input format '" + o.input +
+         "' (use .pcd, .ply, .obj, .off, .xyz or .txt)");
   if (!cocone_app::isMeshFormat(cocone_app::extension(o.output)))
     fail("unknown output format '" + o.output + "' (use .vtk, .ply, .obj or .stl)");
   if (!o.boundary_file.empty() && cocone_app::extension(o.boundary_file) != "pcd")

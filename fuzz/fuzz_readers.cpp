@@ -21,9 +21,9 @@ LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
   if (size < 1)
     return 0;
-  static const char* extensions[] = {"pcd", "ply", "obj", "xyz"};
+  static const char* extensions[] = {"pcd", "ply", "obj", "xyz", "off"};
   const std::string path =
-      "/tmp/cocone_fuzz_" + std::to_string(::getpid()) + "." + extensions[data[0] % 4];
+      "/tmp/cocone_fuzz_" + std::to_string(::getpid()) + "." + extensions[data[0] % 5];
   {
     std::ofstream f(path, std::ios::binary);
     f.write(reinterpret_cast<const char*>(data + 1),

@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cloud_io.h"
 #include "streaming_io.h"
 #include <sys/resource.h>
 
@@ -572,3 +573,28 @@ TEST_F(StreamingIo, PlyMeshWriterReportsAFullDisk)
 }
 
 } // namespace
+
+TEST(CloudIo, OffMeshesVerticesAndFaces)
+{
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "cocone_cloud_io_test.off").string();
+  // Counts on the header's line, normals after x y z, a quad and a triangle.
+  std::ofstream(path) << "NOFF 5 2 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n"
+                         "0 1 0 0 0 1\n# apex\n0.5 0.5 1 0 0 1\n4 0 1 2 3\n3 0 1 4\n";
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> faces;
+  std::string error;
+  ASSERT_TRUE(cocone_app::readOff(path, vertices, &faces, error)) << error;
+  ASSERT_EQ(vertices.size(), 5u);
+  EXPECT_EQ(vertices[4], Eigen::Vector3d(0.5, 0.5, 1.0));
+  const std::vector<std::array<int, 3>> fan = {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}};
+  EXPECT_EQ(faces, fan);
+  // A face naming a vertex the file does not have.
+  std::ofstream(path) << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
+  EXPECT_FALSE(cocone_app::readOff(path, vertices, &faces, error));
+  EXPECT_NE(error.find("missing vertex"), std::string::npos) << error;
+  // Read for the cloud alone, the faces are not looked at.
+  EXPECT_TRUE(cocone_app::readOff(path, vertices, nullptr, error)) << error;
+  EXPECT_EQ(vertices.size(), 3u);
+  std::remove(path.c_str());
+}

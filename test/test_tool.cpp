@@ -59,6 +59,14 @@ protected:
       xyz << p.x << ' ' << p.y << ' ' << p.z << '\n';
       obj << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     }
+    // OFF as CGAL writes it, with a comment, the counts on their own line, colours
+    // after each vertex and a quad face (the faces are not read for the cloud).
+    std::ofstream off(dir_ + "/in.off");
+    off.precision(9);
+    off << "OFF\n# a hemisphere\n" << cloud_->size() << " 1 0\n";
+    for (const auto& p : *cloud_)
+      off << p.x << ' ' << p.y << ' ' << p.z << " 0.5 0.5 0.5 1\n";
+    off << "4 0 1 2 3\n";
     txt << "# x y z\n";
     txt.precision(9);
     for (const auto& p : *cloud_)
@@ -122,7 +130,8 @@ TEST_F(Tool, EveryInputFormatGivesTheLibraryResult)
 {
   const std::size_t expected = libraryTriangles();
   ASSERT_GT(expected, 3000u);
-  for (const std::string in : {"in.pcd", "in.ply", "in.obj", "in.xyz", "in.txt"}) {
+  for (const std::string in :
+       {"in.pcd", "in.ply", "in.obj", "in.off", "in.xyz", "in.txt"}) {
     std::string out;
     ASSERT_EQ(run(dir_ + "/" + in + " " + dir_ + "/out.vtk -q", &out), 0) << in << out;
     pcl::PolygonMesh mesh;
@@ -275,6 +284,10 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
          "HEIGHT 1\nPOINTS 4\nDATA ascii\n\n# data\nCOLUMNS a\n0 0 0\n1 0 0\n0 1 0\n"
          "0 0 1\n";
   std::ofstream(dir_ + "/line.xyz") << "0 0 0\n1 1 1\n2 2 2\n3 3 3\n4 4 4\n";
+  std::ofstream(dir_ + "/binary.off") << "OFF BINARY\n";
+  std::ofstream(dir_ + "/4d.off") << "4OFF\n1 0 0\n0 0 0 0\n";
+  std::ofstream(dir_ + "/short.off") << "OFF\n3 0 0\n0 0 0\n1 0 0\n";
+  std::ofstream(dir_ + "/nocounts.off") << "OFF\n# nothing else\n";
   const std::string in = dir_ + "/in.pcd ";
   const std::pair<std::string, std::string> cases[] = {
       {dir_ + "/missing.pcd " + out, "cannot read"},
@@ -286,6 +299,10 @@ TEST_F(Tool, ErrorsExitNonZeroWithAMessage)
       {dir_ + "/bad.pcd " + out, "cannot read"},
       {dir_ + "/redeclared.pcd " + out, "cannot read"},
       {dir_ + "/line.xyz " + out, "collinear"},
+      {dir_ + "/binary.off " + out, "binary OFF"},
+      {dir_ + "/4d.off " + out, "not a 3D OFF header"},
+      {dir_ + "/short.off " + out, "vertex 2"},
+      {dir_ + "/nocounts.off " + out, "no vertex, face and edge counts"},
       {in + out + " -rho abc", "not a number"},
       {in + out + " -rho -1", "-rho must be positive"},
       {in + out + " -spacing_factor -2", "-spacing_factor"},
@@ -444,7 +461,7 @@ TEST_F(Tool, FuzzCorpusFailsCleanly)
   // Every file the readers' fuzzer kept (crashes of PCL's readers among them): the
   // tool either reads it or says why, and never crashes. The first byte of each
   // corpus file picks the format.
-  const char* extensions[] = {"pcd", "ply", "obj", "xyz"};
+  const char* extensions[] = {"pcd", "ply", "obj", "xyz", "off"};
   std::size_t files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(COCONE_FUZZ_CORPUS)) {
     std::ifstream in(entry.path(), std::ios::binary);
@@ -452,7 +469,8 @@ TEST_F(Tool, FuzzCorpusFailsCleanly)
                       std::istreambuf_iterator<char>());
     if (bytes.empty())
       continue;
-    const std::string input = dir_ + "/fuzz." + extensions[bytes[0] % 4];
+    const std::string input =
+        dir_ + "/fuzz." + extensions[static_cast<unsigned char>(bytes[0]) % 5];
     std::ofstream(input, std::ios::binary) << bytes.substr(1);
     std::string log;
     const int code = run(input + " " + dir_ + "/fuzz.vtk -q", &log);
