@@ -623,6 +623,64 @@ TEST(Repair, BorderSliversArePeeledOneLayer)
   EXPECT_EQ(pcl::cocone::peelBorderSlivers(points, mesh, incidences, loops), 0u);
 }
 
+TEST(Repair, BridgeAcrossAGapIsDroppedAndANarrowJoinKept)
+{
+  // Two square grids of spacing 1, the second `gap` beyond the first along x, joined
+  // at their facing borders by a strip of two triangles (the walk's bridge between
+  // two bodies a few spacings apart): the strip goes if its shared edge is longer
+  // than 3 spacings, and stays where the grids are a spacing apart.
+  const auto grids = [](double gap, std::vector<Eigen::Vector3d>& points) {
+    constexpr int N = 6; // vertices per side
+    points.clear();
+    std::vector<pcl::cocone::Triangle> mesh;
+    for (const double x0 : {0.0, N - 1 + gap}) {
+      const int first = static_cast<int>(points.size());
+      for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i)
+          points.emplace_back(x0 + i, j, 0.0);
+      const auto id = [first](int i, int j) { return first + j * N + i; };
+      for (int j = 0; j + 1 < N; ++j)
+        for (int i = 0; i + 1 < N; ++i) {
+          mesh.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+          mesh.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    }
+    // The strip: the first grid's right border (i = N - 1) runs up, the second's
+    // left border (i = 0) down; a2 -> a3 and b3 -> b2 are border edges.
+    const int a2 = 2 * N + N - 1, a3 = 3 * N + N - 1, b2 = N * N + 2 * N,
+              b3 = N * N + 3 * N;
+    mesh.push_back({a3, a2, b2});
+    mesh.push_back({a3, b2, b3});
+    return mesh;
+  };
+  std::vector<Eigen::Vector3d> points;
+  for (const double gap : {5.0, 1.0}) {
+    std::vector<pcl::cocone::Triangle> mesh = grids(gap, points);
+    const std::vector<double> spacing(points.size(), 1.0);
+    ASSERT_EQ(pcl::cocone::analyzeMesh(mesh, points.size()).components, 1u);
+    pcl::cocone::EdgeIncidences incidences(mesh);
+    const std::size_t dropped =
+        pcl::cocone::dropBridges(points, spacing, 3.0, mesh, &incidences);
+    const auto after = pcl::cocone::analyzeMesh(mesh, points.size());
+    EXPECT_TRUE(after.manifold());
+    if (gap > 3.0) {
+      EXPECT_EQ(dropped, 2u);
+      EXPECT_EQ(after.components, 2u);
+      EXPECT_EQ(pcl::cocone::boundaryLoops(mesh, points.size()).size(), 2u);
+    }
+    else {
+      EXPECT_EQ(dropped, 0u);
+      EXPECT_EQ(after.components, 1u);
+    }
+    const pcl::cocone::EdgeIncidences fresh(mesh);
+    EXPECT_EQ(incidences.edges, fresh.edges);
+    EXPECT_EQ(incidences.triangle, fresh.triangle);
+  }
+  // Without spacings nothing is judged.
+  std::vector<pcl::cocone::Triangle> mesh = grids(5.0, points);
+  EXPECT_EQ(pcl::cocone::dropBridges(points, {}, 3.0, mesh), 0u);
+}
+
 TEST(Repair, MoebiusStripIsCutWhereItCannotBeOriented)
 {
   // A band of 2n triangles with a half twist: no orientation agrees all round, so

@@ -192,6 +192,12 @@ unmeshedParts(std::size_t n,
   return any ? region : std::vector<std::uint8_t>();
 }
 
+/** The longest edge, in local spacings, of a bridge between two parts of the walk's
+ * mesh that is kept (dropBridges()): CGAL's knot2, two linked tori 5 spacings
+ * apart, had one of 6; the strips one triangle wide within a part on CGAL's
+ * example meshes have edges of 0.3 to 1.8 (median edge lengths round them). */
+constexpr double BRIDGE_SPACINGS = 3.0;
+
 /** Stages 4-7 and the repair, up to the undersampled holes: the oriented manifold
  * mesh over vertex ids and its border loops; returns its edge incidences. */
 EdgeIncidences
@@ -236,6 +242,8 @@ walkSurface(Triangulation& dt,
                                      &incidences);
   }
   counts.repair.ribbon = dropRibbons(result.triangles, dt.points.size(), &incidences);
+  counts.repair.ribbon +=
+      dropBridges(dt.points, spacing, BRIDGE_SPACINGS, result.triangles, &incidences);
   if (parameters.fill_undersampled_holes && !spacing.empty()) {
     const std::vector<std::uint8_t> unmeshed = unmeshedParts(
         dt.points.size(), cells.triangles, within_reach, result.triangles);

@@ -14,6 +14,7 @@
 #include "parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <queue>
 #include <tuple>
@@ -520,6 +521,149 @@ dropRibbons(std::vector<Triangle>& triangles,
                                 ribbon[component[t]] = 0;
                           return ribbon;
                         });
+}
+
+namespace {
+
+/** The edges that are bridges of the dual graph of \a triangles (triangles joined
+ * through the edges they share, incidences \a inc): each edge id whose two triangles
+ * are joined through it alone. Tarjan's lowpoint search, iterative. */
+std::vector<std::size_t>
+dualBridges(const std::vector<Triangle>& triangles, const EdgeIncidences& inc)
+{
+  const std::size_t n = triangles.size();
+  // Per triangle its neighbours across its shared edges, and those edges.
+  std::vector<std::array<int, 3>> across(n, {-1, -1, -1});
+  std::vector<std::array<std::ptrdiff_t, 3>> via(n, {-1, -1, -1});
+  std::vector<std::uint8_t> degree(n, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 2) {
+      const int s = inc.triangle[inc.first[e]], t = inc.triangle[inc.first[e] + 1];
+      across[s][degree[s]] = t;
+      via[s][degree[s]++] = static_cast<std::ptrdiff_t>(e);
+      across[t][degree[t]] = s;
+      via[t][degree[t]++] = static_cast<std::ptrdiff_t>(e);
+    }
+  std::vector<int> order(n, -1), low(n, 0);
+  std::vector<std::ptrdiff_t> entered_by(n, -1);
+  std::vector<std::pair<int, int>> stack; // (triangle, next neighbour slot)
+  std::vector<std::size_t> bridges;
+  int clock = 0;
+  for (std::size_t root = 0; root < n; ++root) {
+    if (order[root] >= 0)
+      continue;
+    order[root] = low[root] = clock++;
+    stack.emplace_back(static_cast<int>(root), 0);
+    while (!stack.empty()) {
+      auto& [t, slot] = stack.back();
+      if (slot < degree[t]) {
+        const int u = across[t][slot];
+        const std::ptrdiff_t e = via[t][slot++];
+        if (e == entered_by[t])
+          continue;
+        if (order[u] < 0) {
+          order[u] = low[u] = clock++;
+          entered_by[u] = e;
+          stack.emplace_back(u, 0);
+        }
+        else
+          low[t] = std::min(low[t], order[u]);
+        continue;
+      }
+      const int done = t;
+      stack.pop_back();
+      if (stack.empty())
+        break;
+      const int parent = stack.back().first;
+      low[parent] = std::min(low[parent], low[done]);
+      if (low[done] > order[parent])
+        bridges.push_back(static_cast<std::size_t>(entered_by[done]));
+    }
+  }
+  return bridges;
+}
+
+} // namespace
+
+std::size_t
+dropBridges(const std::vector<Eigen::Vector3d>& points,
+            const std::vector<double>& spacing,
+            double max_spacings,
+            std::vector<Triangle>& triangles,
+            EdgeIncidences* incidences)
+{
+  if (spacing.empty() || triangles.empty())
+    return 0;
+  EdgeIncidences local;
+  EdgeIncidences& inc = incidences ? *incidences : local;
+  if (!inc.grouped())
+    inc = EdgeIncidences(triangles);
+  std::size_t dropped = 0;
+  for (;;) {
+    // A bridge's ends are both on borders (round an inner vertex the fan joins the
+    // two triangles the other way): without a long edge between border vertices
+    // there is none to look for, and the mesh is not searched.
+    std::vector<std::uint8_t> on_border(points.size(), 0);
+    for (std::size_t e = 0; e < inc.edges.size(); ++e)
+      if (inc.count(e) == 1)
+        on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] = 1;
+    const auto long_edge = [&](std::size_t e) {
+      const int a = inc.edges[e][0], b = inc.edges[e][1];
+      const double reach = max_spacings * std::max(spacing[a], spacing[b]);
+      return inc.count(e) == 2 && on_border[a] && on_border[b] &&
+             (points[a] - points[b]).squaredNorm() > reach * reach;
+    };
+    bool any = false;
+    for (std::size_t e = 0; e < inc.edges.size() && !any; ++e)
+      any = long_edge(e);
+    if (!any)
+      return dropped;
+    // One bridge per pass, the first whose triangles leave each of their corners
+    // one fan (one manifold mesh, as the hole filling needs): a corner's fan, less
+    // some triangles, falls into as many fans as it has triangles more than inner
+    // edges (those left with both their triangles).
+    const auto one_fan_each = [&](int s, int t) {
+      std::array<int, 4> corners{};
+      std::size_t k = 0;
+      for (const int v : triangles[s])
+        corners[k++] = v;
+      for (const int v : triangles[t])
+        if (std::find(corners.begin(), corners.begin() + k, v) == corners.begin() + k)
+          corners[k++] = v;
+      std::array<long, 4> fans{};
+      const auto corner = [&](int v) {
+        return std::find(corners.begin(), corners.begin() + k, v) - corners.begin();
+      };
+      for (std::size_t u = 0; u < triangles.size(); ++u)
+        if (static_cast<int>(u) != s && static_cast<int>(u) != t)
+          for (const int v : triangles[u])
+            if (corner(v) < static_cast<std::ptrdiff_t>(k))
+              ++fans[corner(v)];
+      for (std::size_t e = 0; e < inc.edges.size(); ++e) {
+        if (inc.count(e) != 2)
+          continue;
+        const int x = inc.triangle[inc.first[e]], y = inc.triangle[inc.first[e] + 1];
+        if (x == s || x == t || y == s || y == t)
+          continue;
+        for (const int v : inc.edges[e])
+          if (corner(v) < static_cast<std::ptrdiff_t>(k))
+            --fans[corner(v)];
+      }
+      return std::all_of(fans.begin(), fans.begin() + k, [](long f) { return f <= 1; });
+    };
+    std::vector<std::uint8_t> drop;
+    for (const std::size_t e : dualBridges(triangles, inc)) {
+      const int s = inc.triangle[inc.first[e]], t = inc.triangle[inc.first[e] + 1];
+      if (long_edge(e) && one_fan_each(s, t)) {
+        drop.assign(triangles.size(), 0);
+        drop[s] = drop[t] = 1;
+        break;
+      }
+    }
+    if (drop.empty())
+      return dropped;
+    dropped += removeTriangles(triangles, drop, &inc);
+  }
 }
 
 std::size_t

@@ -30,7 +30,8 @@ struct RepairCounts {
   std::size_t flipped = 0;
   /** Added to close small holes (see fillHoles()). */
   std::size_t filled = 0;
-  /** Dropped with components that have no inner vertex (see dropRibbons()). */
+  /** Dropped with components that have no inner vertex (see dropRibbons()) or as
+   * bridges across gaps (see dropBridges()). */
   std::size_t ribbon = 0;
   /** Dropped with components of too few vertices (see dropSpecks()) or within a
    * spacing of a larger one (see dropLayers()). */
@@ -111,6 +112,30 @@ fillHoles(const std::vector<Eigen::Vector3d>& points,
 std::size_t
 dropRibbons(std::vector<Triangle>& triangles,
             std::size_t num_vertices,
+            EdgeIncidences* incidences = nullptr);
+
+/** \brief Drop the bridges across gaps: two triangles whose shared edge is all that
+ * joins two parts of the mesh (a bridge of the dual graph) and is longer than
+ * \a max_spacings local spacings of both its ends.
+ *
+ * Where two bodies pass a few spacings apart (two linked tori of CGAL's knot2,
+ * 5 spacings), the walk can join them by a strip of two long triangles whose
+ * sides lie on the borders round it: one surface then, with a loop round the
+ * strip. A surface the sample resolves is wider than a triangle wherever it joins
+ * two parts, and its edges are about a spacing long; such a strip is neither. The
+ * strips one triangle wide within a part (a thin fin, an antler's tip) have edges
+ * of about a spacing and stay. Repeated until no such bridge is left.
+ * \param[in] points the vertex positions
+ * \param[in] spacing per vertex its local spacing; empty: nothing is dropped
+ * \param[in] max_spacings the longest bridge edge kept, in local spacings
+ * \param[in,out] incidences as for dropSpecks()
+ * \return the number of triangles dropped
+ */
+std::size_t
+dropBridges(const std::vector<Eigen::Vector3d>& points,
+            const std::vector<double>& spacing,
+            double max_spacings,
+            std::vector<Triangle>& triangles,
             EdgeIncidences* incidences = nullptr);
 
 /** \brief Drop every component of the mesh with fewer than \a min_vertices
