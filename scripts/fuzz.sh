@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 bash scripts/install_deps.sh
 build=${BUILD_DIR:-build-fuzz}
+case $build in /*) ;; *) build=$PWD/$build ;; esac # the fuzzers run in another directory
 CC=clang CXX=clang++ cmake -S fuzz -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 cmake --build "$build" -j"$(nproc)"
 work=$(mktemp -d)
@@ -18,7 +19,7 @@ for target in pipeline readers; do
   mkdir -p "$work/$target"
   cp fuzz/corpus/$target/* "$work/$target/"
   echo "== fuzz_$target: fuzzing for $seconds s"
-  (cd "$work" && "$OLDPWD/$build/fuzz_$target" "$target" -max_total_time="$seconds" \
+  (cd "$work" && "$build/fuzz_$target" "$target" -max_total_time="$seconds" \
      -rss_limit_mb=2048 -print_final_stats=1 > "fuzz_$target.log" 2>&1) ||
     { tail -40 "$work/fuzz_$target.log"
       # The report's head (the stack) and the unit itself, kept beside the build:
