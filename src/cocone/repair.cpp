@@ -618,49 +618,59 @@ dropBridges(const std::vector<Eigen::Vector3d>& points,
       any = long_edge(e);
     if (!any)
       return dropped;
-    // One bridge per pass, the first whose triangles leave each of their corners
-    // one fan (one manifold mesh, as the hole filling needs): a corner's fan, less
-    // some triangles, falls into as many fans as it has triangles more than inner
-    // edges (those left with both their triangles).
-    const auto one_fan_each = [&](int s, int t) {
-      std::array<int, 4> corners{};
-      std::size_t k = 0;
-      for (const int v : triangles[s])
-        corners[k++] = v;
-      for (const int v : triangles[t])
-        if (std::find(corners.begin(), corners.begin() + k, v) == corners.begin() + k)
-          corners[k++] = v;
-      std::array<long, 4> fans{};
-      const auto corner = [&](int v) {
-        return std::find(corners.begin(), corners.begin() + k, v) - corners.begin();
-      };
-      for (std::size_t u = 0; u < triangles.size(); ++u)
-        if (static_cast<int>(u) != s && static_cast<int>(u) != t)
-          for (const int v : triangles[u])
-            if (corner(v) < static_cast<std::ptrdiff_t>(k))
-              ++fans[corner(v)];
-      for (std::size_t e = 0; e < inc.edges.size(); ++e) {
-        if (inc.count(e) != 2)
-          continue;
-        const int x = inc.triangle[inc.first[e]], y = inc.triangle[inc.first[e] + 1];
-        if (x == s || x == t || y == s || y == t)
-          continue;
-        for (const int v : inc.edges[e])
-          if (corner(v) < static_cast<std::ptrdiff_t>(k))
-            --fans[corner(v)];
-      }
-      return std::all_of(fans.begin(), fans.begin() + k, [](long f) { return f <= 1; });
-    };
-    std::vector<std::uint8_t> drop;
+    // The bridges whose triangles leave each of their corners one fan (one manifold
+    // mesh, as the hole filling needs): a corner's fan, less some triangles, falls
+    // into as many fans as it has triangles more than inner edges (those left with
+    // both their triangles). Counted once per pass; the bridges dropped in a pass
+    // share no corner, so that the counts hold for each.
+    std::vector<int> fans(points.size(), 0);
+    for (const auto& t : triangles)
+      for (const int v : t)
+        ++fans[v];
+    for (std::size_t e = 0; e < inc.edges.size(); ++e)
+      if (inc.count(e) == 2)
+        --fans[inc.edges[e][0]], --fans[inc.edges[e][1]];
+    std::vector<std::uint8_t> drop(triangles.size(), 0), taken(points.size(), 0);
+    std::size_t found = 0;
     for (const std::size_t e : dualBridges(triangles, inc)) {
-      const int s = inc.triangle[inc.first[e]], t = inc.triangle[inc.first[e] + 1];
-      if (long_edge(e) && one_fan_each(s, t)) {
-        drop.assign(triangles.size(), 0);
-        drop[s] = drop[t] = 1;
-        break;
-      }
+      if (!long_edge(e))
+        continue;
+      const std::array<int, 2> pair = {inc.triangle[inc.first[e]],
+                                       inc.triangle[inc.first[e] + 1]};
+      // Their corners, and per corner the triangles and inner edges they take.
+      std::array<int, 4> corner{};
+      std::array<int, 4> left{};
+      std::size_t k = 0;
+      const auto at = [&](int v) {
+        const auto i =
+            std::find(corner.begin(), corner.begin() + k, v) - corner.begin();
+        if (static_cast<std::size_t>(i) == k) {
+          corner[k] = v;
+          left[k++] = fans[v];
+        }
+        return i;
+      };
+      for (const int t : pair)
+        for (int c = 0; c < 3; ++c) {
+          const int v = triangles[t][c], w = triangles[t][(c + 1) % 3];
+          --left[at(v)];
+          const std::ptrdiff_t edge = inc.find(v, w);
+          // An inner edge of both triangles (the bridge) is counted once.
+          if (inc.count(static_cast<std::size_t>(edge)) == 2 &&
+              (static_cast<std::size_t>(edge) != e || t == pair[0]))
+            ++left[at(v)], ++left[at(w)];
+        }
+      bool ok = true;
+      for (std::size_t i = 0; i < k; ++i)
+        ok = ok && left[i] <= 1 && !taken[corner[i]];
+      if (!ok)
+        continue;
+      for (std::size_t i = 0; i < k; ++i)
+        taken[corner[i]] = 1;
+      drop[pair[0]] = drop[pair[1]] = 1;
+      ++found;
     }
-    if (drop.empty())
+    if (found == 0)
       return dropped;
     dropped += removeTriangles(triangles, drop, &inc);
   }
