@@ -318,6 +318,28 @@ xyzCloud(const std::vector<Eigen::Vector3d>& xyz, pcl::PCLPointCloud2& cloud)
   pcl::toPCLPointCloud2(points, cloud);
 }
 
+/** The next line of \a in without its comment ('#' to the end), \a number counting
+ * the lines read; false at the end. */
+bool
+readDataLine(std::istream& in, std::string& line, std::size_t& number)
+{
+  if (!std::getline(in, line))
+    return false;
+  ++number;
+  const auto hash = line.find('#');
+  if (hash != std::string::npos)
+    line.resize(hash);
+  return true;
+}
+
+/** A polygon's corners as a fan of triangles from its first, appended to \a out. */
+void
+appendFan(const std::vector<int>& polygon, std::vector<std::array<int, 3>>& out)
+{
+  for (std::size_t k = 2; k < polygon.size(); ++k)
+    out.push_back({polygon[0], polygon[k - 1], polygon[k]});
+}
+
 /** Read whitespace-separated x y z lines; '#' starts a comment. With \a obj, only
  * the vertex lines ("v x y z") of a Wavefront file count. PCL's OBJ reader crashes on
  * a vertex line with fewer than three numbers, so OBJ files are read here too. */
@@ -331,11 +353,7 @@ readText(const std::string& path,
   std::vector<Eigen::Vector3d> xyz;
   std::string line;
   std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const auto hash = line.find('#');
-    if (hash != std::string::npos)
-      line.resize(hash);
+  while (readDataLine(in, line, number)) {
     std::istringstream fields(line);
     if (obj) {
       std::string tag;
@@ -381,17 +399,12 @@ readOff(const std::string& path,
   std::size_t number = 0;
   // The next line that is not blank or a comment, as a stream of its fields.
   const auto next = [&](std::istringstream& fields) {
-    while (std::getline(in, line)) {
-      ++number;
-      const auto hash = line.find('#');
-      if (hash != std::string::npos)
-        line.resize(hash);
+    while (readDataLine(in, line, number))
       if (line.find_first_not_of(" \t\r") != std::string::npos) {
         fields.clear();
         fields.str(line);
         return true;
       }
-    }
     return false;
   };
   const auto fail = [&](const std::string& why) {
@@ -432,19 +445,65 @@ readOff(const std::string& path,
   if (!faces)
     return true;
   faces->clear();
+  std::vector<int> face;
   for (std::size_t f = 0; f < counts[1]; ++f) {
     std::size_t corners = 0;
     if (!next(fields) || !(fields >> token) || !parseCount(token, corners))
       return fail("face " + std::to_string(f) + " has no corner count");
-    std::vector<int> face;
+    face.clear();
     for (std::size_t c = 0; c < corners; ++c) {
       std::size_t v = 0;
       if (!(fields >> token) || !parseCount(token, v) || v >= vertices.size())
         return fail("face " + std::to_string(f) + " names a missing vertex");
       face.push_back(static_cast<int>(v));
     }
-    for (std::size_t k = 2; k < face.size(); ++k)
-      faces->push_back({face[0], face[k - 1], face[k]});
+    appendFan(face, *faces);
+  }
+  return true;
+}
+
+bool
+readFaces(const std::string& path,
+          std::vector<std::array<int, 3>>& faces,
+          std::string& error)
+{
+  faces.clear();
+  if (extension(path) == "off") {
+    std::vector<Eigen::Vector3d> vertices;
+    return readOff(path, vertices, &faces, error);
+  }
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot read '" + path + "'";
+    return false;
+  }
+  long vertices = 0;
+  std::string line;
+  std::size_t number = 0;
+  std::vector<int> face;
+  while (readDataLine(in, line, number)) {
+    std::istringstream fields(line);
+    std::string tag;
+    if (!(fields >> tag))
+      continue;
+    if (tag == "v")
+      ++vertices;
+    if (tag != "f")
+      continue;
+    face.clear();
+    std::string corner;
+    while (fields >> corner) {
+      // v, v/vt, v//vn or v/vt/vn: the vertex is the first number.
+      char* end = nullptr;
+      const long i = std::strtol(corner.c_str(), &end, 10);
+      const long v = i > 0 ? i - 1 : vertices + i;
+      if (end == corner.c_str() || i == 0 || v < 0 || v >= vertices) {
+        error = "line " + std::to_string(number) + ": bad vertex '" + corner + "'";
+        return false;
+      }
+      face.push_back(static_cast<int>(v));
+    }
+    appendFan(face, faces);
   }
   return true;
 }

@@ -49,6 +49,16 @@ readOff(const std::string& path,
         std::vector<std::array<int, 3>>* faces,
         std::string& error);
 
+/** Read the faces of a mesh file, .obj (Wavefront: polygons over its vertex lines,
+ * numbered from 1, negative indices counting back from the last vertex read) or .off
+ * (readOff()), as triangles (polygons as fans) over its vertices numbered from 0.
+ * False, and why in \a error, if the file cannot be read or a face names a missing
+ * vertex. */
+bool
+readFaces(const std::string& path,
+          std::vector<std::array<int, 3>>& faces,
+          std::string& error);
+
 /** Read a point cloud (.pcd, .ply, .obj, .off, .xyz/.txt/.pts, or the registered range
  * scans a Stanford .conf lists, merged); on failure return false and say why in
  * \a error. Only the vertices of a mesh file are read. */

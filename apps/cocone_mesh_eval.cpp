@@ -52,10 +52,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <functional>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -109,58 +107,6 @@ struct Truth {
   std::size_t unreferenced = 0; ///< vertices in no face (mesh only)
   std::size_t loops = 0;        ///< border loops of the faces (mesh only)
 };
-
-/** Read the faces of a Wavefront file as triangles (polygons as fans) over its
- * vertex lines, numbered from 0; negative indices count back from the last vertex
- * read. False, and why in \a error, if a face names a missing vertex. */
-bool
-readObjFaces(const std::string& path,
-             std::vector<Triangle>& triangles,
-             std::size_t& vertices,
-             std::string& error)
-{
-  std::ifstream in(path);
-  if (!in) {
-    error = "cannot read '" + path + "'";
-    return false;
-  }
-  vertices = 0;
-  std::string line;
-  std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const auto hash = line.find('#');
-    if (hash != std::string::npos)
-      line.resize(hash);
-    std::istringstream fields(line);
-    std::string tag;
-    if (!(fields >> tag))
-      continue;
-    if (tag == "v") {
-      ++vertices;
-      continue;
-    }
-    if (tag != "f")
-      continue;
-    std::vector<int> face;
-    std::string corner;
-    while (fields >> corner) {
-      // v, v/vt, v//vn or v/vt/vn: the vertex is the first number.
-      char* end = nullptr;
-      const long i = std::strtol(corner.c_str(), &end, 10);
-      const long v = i > 0 ? i - 1 : static_cast<long>(vertices) + i;
-      if (end == corner.c_str() || i == 0 || v < 0 ||
-          v >= static_cast<long>(vertices)) {
-        error = "line " + std::to_string(number) + ": bad vertex '" + corner + "'";
-        return false;
-      }
-      face.push_back(static_cast<int>(v));
-    }
-    for (std::size_t k = 2; k < face.size(); ++k)
-      triangles.push_back({face[0], face[k - 1], face[k]});
-  }
-  return true;
-}
 
 /** The border loops of a triangle mesh of any kind: the cycles of its directed
  * boundary half-edges (edges in one triangle, as that triangle traverses them).
@@ -459,10 +405,7 @@ main(int argc, char** argv)
     const std::string ext = cocone_app::extension(path);
     if (ext == "obj" || ext == "off") {
       std::vector<Triangle> faces;
-      std::size_t vertices = 0;
-      std::vector<Eigen::Vector3d> off_vertices;
-      if (ext == "obj" ? !readObjFaces(path, faces, vertices, error)
-                       : !cocone_app::readOff(path, off_vertices, &faces, error)) {
+      if (!cocone_app::readFaces(path, faces, error)) {
         std::fprintf(stderr, "%s: %s\n", path.c_str(), error.c_str());
         status = 1;
         continue;

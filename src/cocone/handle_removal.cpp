@@ -817,10 +817,7 @@ cutShortNecks(const std::vector<Eigen::Vector3d>& points,
   const int depth_limit = static_cast<int>(max_edges / 2);
   const VertexEdges at(incidences, num_vertices);
   // Borders and what lies on them are no place for a neck's cycle.
-  std::vector<std::uint8_t> touched(num_vertices, 0);
-  for (std::size_t e = 0; e < incidences.edges.size(); ++e)
-    if (incidences.count(e) == 1)
-      touched[incidences.edges[e][0]] = touched[incidences.edges[e][1]] = 1;
+  std::vector<std::uint8_t> touched = borderMask(incidences, num_vertices);
   // Every cycle of two breadth-first paths from a seed and an edge, of 3 to
   // max_edges edges.
   std::vector<Cycle> cycles;

@@ -382,6 +382,16 @@ borderVertices(const std::vector<Triangle>& triangles)
 }
 
 std::vector<std::uint8_t>
+borderMask(const EdgeIncidences& inc, std::size_t num_vertices)
+{
+  std::vector<std::uint8_t> border(num_vertices, 0);
+  for (std::size_t e = 0; e < inc.edges.size(); ++e)
+    if (inc.count(e) == 1)
+      border[inc.edges[e][0]] = border[inc.edges[e][1]] = 1;
+  return border;
+}
+
+std::vector<std::uint8_t>
 usedVertices(const std::vector<Triangle>& triangles, std::size_t num_vertices)
 {
   std::vector<std::uint8_t> used(num_vertices, 0);

@@ -540,7 +540,8 @@ handleNoise(Triangulation& dt,
       parameters.boundary_detection && stages == Stages::RECONSTRUCTION;
   double given_height = 0.0; // medianPoleHeight() of the given points
   if (noise.cloud_level > parameters.noise_threshold) {
-    given_height = medianPoleHeight(cells, mean_spacing, noise.outlier, counted);
+    if (two_scales) // read only where both scales may run
+      given_height = medianPoleHeight(cells, mean_spacing, noise.outlier, counted);
     // Not held through the smoothing's peak (the stages after read them again if
     // the given points' triangulation stands).
     std::vector<double>().swap(mean_spacing);

@@ -509,11 +509,8 @@ dropRibbons(std::vector<Triangle>& triangles,
                         [&](const EdgeIncidences& inc,
                             const std::vector<int>& component,
                             std::size_t count) {
-                          std::vector<std::uint8_t> on_border(num_vertices, 0);
-                          for (std::size_t e = 0; e < inc.edges.size(); ++e)
-                            if (inc.count(e) == 1)
-                              on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] =
-                                  1;
+                          const std::vector<std::uint8_t> on_border =
+                              borderMask(inc, num_vertices);
                           std::vector<std::uint8_t> ribbon(count, 1);
                           for (std::size_t t = 0; t < triangles.size(); ++t)
                             for (const int v : triangles[t])
@@ -603,10 +600,7 @@ dropBridges(const std::vector<Eigen::Vector3d>& points,
     // A bridge's ends are both on borders (round an inner vertex the fan joins the
     // two triangles the other way): without a long edge between border vertices
     // there is none to look for, and the mesh is not searched.
-    std::vector<std::uint8_t> on_border(points.size(), 0);
-    for (std::size_t e = 0; e < inc.edges.size(); ++e)
-      if (inc.count(e) == 1)
-        on_border[inc.edges[e][0]] = on_border[inc.edges[e][1]] = 1;
+    const std::vector<std::uint8_t> on_border = borderMask(inc, points.size());
     const auto long_edge = [&](std::size_t e) {
       const int a = inc.edges[e][0], b = inc.edges[e][1];
       const double reach = max_spacings * std::max(spacing[a], spacing[b]);

@@ -122,6 +122,11 @@ boundaryLoops(const EdgeIncidences& inc, std::size_t num_vertices);
 std::vector<int>
 borderVertices(const std::vector<Triangle>& triangles);
 
+/** \brief Per vertex (of \a num_vertices): whether it is an end of an edge in
+ * exactly one triangle (\a inc): the border vertices, as a mask. */
+std::vector<std::uint8_t>
+borderMask(const EdgeIncidences& inc, std::size_t num_vertices);
+
 /** \brief Per vertex (of \a num_vertices): whether a triangle uses it. */
 std::vector<std::uint8_t>
 usedVertices(const std::vector<Triangle>& triangles, std::size_t num_vertices);
