@@ -19,13 +19,16 @@
 
 // Sweeps the generated surfaces of the tests over sizes, samplings and seeds and
 // compares each default reconstruction's topology with the truth
-// (build/test/cocone_generated_sweep [--noise S] [--sizes N,N,...] [--seeds K]
-// [--threads T] [--failures] [--write DIR]): per case the components, border loops and
-// Euler characteristic found and true, and the samples set aside as outliers (on a
-// clean cloud every one is false); then per surface and in all the cases whose topology
-// is wrong (--write: the clouds of those cases as DIR/NAME.xyz, to look into). Where
-// the tests check chosen cases, this shows how often a surface of
-// each kind comes out right.
+// (build/test/cocone_generated_sweep [--noise S] [--views V] [--sizes N,N,...]
+// [--seeds K] [--threads T] [--failures] [--write DIR]): per case the components,
+// border loops and Euler characteristic found and true, and the samples set aside as
+// outliers (on a clean cloud every one is false); then per surface and in all the cases
+// whose topology is wrong (--write: the clouds of those cases as DIR/NAME.xyz, to look
+// into). Where the tests check chosen cases, this shows how often a surface of each
+// kind comes out right. --views V: each case is V registered range views of the surface
+// (rangeViews(): a registration error of half a spacing, the noise S in each view); a
+// case whose views leave part of the surface unseen has no known topology and is
+// counted apart.
 using namespace cocone_test;
 
 namespace {
@@ -44,7 +47,7 @@ struct Sampling {
 };
 
 struct Tally {
-  std::size_t cases = 0, wrong = 0, extra_loops = 0, false_outliers = 0;
+  std::size_t cases = 0, wrong = 0, extra_loops = 0, false_outliers = 0, unseen = 0;
 };
 
 std::vector<std::size_t>
@@ -89,6 +92,7 @@ int
 main(int argc, char** argv)
 {
   double noise = 0.0;
+  int views = 0;
   std::vector<std::size_t> sizes{3000, 10000};
   unsigned long seeds = 2;
   int threads = 1;
@@ -98,6 +102,8 @@ main(int argc, char** argv)
     const std::string arg = argv[a];
     if (arg == "--noise" && a + 1 < argc)
       noise = std::strtod(argv[++a], nullptr);
+    else if (arg == "--views" && a + 1 < argc)
+      views = std::atoi(argv[++a]);
     else if (arg == "--sizes" && a + 1 < argc)
       sizes = parseSizes(argv[++a]);
     else if (arg == "--seeds" && a + 1 < argc)
@@ -111,11 +117,12 @@ main(int argc, char** argv)
     else
       sizes.clear();
   }
-  if (sizes.empty() || seeds < 1 || !(noise >= 0.0) || threads < 0) {
+  if (sizes.empty() || seeds < 1 || !(noise >= 0.0) || threads < 0 || views < 0) {
     std::fprintf(stderr,
-                 "usage: %s [--noise S] [--sizes N,N,...] [--seeds K] [--threads T] "
-                 "[--failures] [--write DIR]\n  S: noise sigma in spacings (default "
-                 "0); N: at least "
+                 "usage: %s [--noise S] [--views V] [--sizes N,N,...] [--seeds K] "
+                 "[--threads T] [--failures] [--write DIR]\n  S: noise sigma in "
+                 "spacings (default 0); V: registered range views of each surface "
+                 "(default 0: the surface's samples); N: at least "
                  "100 points (default 3000,10000); K: seeds 1 to K (default 2)\n",
                  argv[0]);
     return 2;
@@ -142,7 +149,13 @@ main(int argc, char** argv)
 
   pcl::cocone::Parameters parameters;
   parameters.threads = threads;
-  std::printf("noise sigma %.2f spacings, default parameters\n\n", noise);
+  if (views > 0)
+    std::printf("%d range views registered within half a spacing, noise sigma %.2f "
+                "spacings in each, default parameters\n\n",
+                views,
+                noise);
+  else
+    std::printf("noise sigma %.2f spacings, default parameters\n\n", noise);
   std::printf("| surface | points | sampling | seed | truth (components, loops, χ) | "
               "found | outliers | |\n|---|--:|---|--:|---|---|--:|---|\n");
   std::vector<Tally> tally(surfaces.size());
@@ -150,9 +163,16 @@ main(int argc, char** argv)
     for (const std::size_t n : sizes)
       for (const Sampling& sampling : samplings)
         for (unsigned long seed = 1; seed <= seeds; ++seed) {
-          SampleOptions o = options(n, noise, sampling.density_ratio, sampling.even);
+          SampleOptions o = options(
+              n, views > 0 ? 0.0 : noise, sampling.density_ratio, sampling.even);
           o.seed = seed;
-          const Sample s = surfaces[k].make(o);
+          const Sample s =
+              views > 0 ? rangeViews(surfaces[k].make(o), views, 0.5, seed, noise)
+                        : surfaces[k].make(o);
+          if (s.boundary_loops < 0) { // the views leave part of it unseen
+            ++tally[k].unseen;
+            continue;
+          }
           const pcl::cocone::Result r = pcl::cocone::run(
               s.points, parameters, pcl::cocone::Stages::RECONSTRUCTION);
           const MeshScore m = scoreMesh(s, r);
@@ -192,26 +212,33 @@ main(int argc, char** argv)
           std::fflush(stdout);
         }
 
-  std::printf("\n| surface | cases | topology wrong | extra loops | outliers |\n"
-              "|---|--:|--:|--:|--:|\n");
+  // With views, the cases whose views left part of the surface unseen too.
+  const char* unseen_head = views > 0 ? " unseen |" : "";
+  std::printf("\n| surface | cases | topology wrong | extra loops | outliers |%s\n"
+              "|---|--:|--:|--:|--:|%s\n",
+              unseen_head,
+              views > 0 ? "--:|" : "");
   Tally all;
-  for (std::size_t k = 0; k < surfaces.size(); ++k) {
-    const Tally& t = tally[k];
-    std::printf("| %s | %zu | %zu | %zu | %zu |\n",
-                surfaces[k].name.c_str(),
+  const auto row = [&](const std::string& name, const Tally& t) {
+    std::printf("| %s | %zu | %zu | %zu | %zu |",
+                name.c_str(),
                 t.cases,
                 t.wrong,
                 t.extra_loops,
                 t.false_outliers);
+    if (views > 0)
+      std::printf(" %zu |", t.unseen);
+    std::printf("\n");
+  };
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const Tally& t = tally[k];
+    row(surfaces[k].name, t);
     all.cases += t.cases;
     all.wrong += t.wrong;
     all.extra_loops += t.extra_loops;
     all.false_outliers += t.false_outliers;
+    all.unseen += t.unseen;
   }
-  std::printf("| all | %zu | %zu | %zu | %zu |\n",
-              all.cases,
-              all.wrong,
-              all.extra_loops,
-              all.false_outliers);
+  row("all", all);
   return 0;
 }
