@@ -48,6 +48,17 @@ struct Sampling {
 
 struct Tally {
   std::size_t cases = 0, wrong = 0, extra_loops = 0, false_outliers = 0, unseen = 0;
+
+  Tally&
+  operator+=(const Tally& t)
+  {
+    cases += t.cases;
+    wrong += t.wrong;
+    extra_loops += t.extra_loops;
+    false_outliers += t.false_outliers;
+    unseen += t.unseen;
+    return *this;
+  }
 };
 
 std::vector<std::size_t>
@@ -192,7 +203,8 @@ main(int argc, char** argv)
           if (!right && !write_dir.empty())
             writeCloud(write_dir,
                        surfaces[k].name + " " + std::to_string(n) + " " +
-                           sampling.name + " " + std::to_string(seed),
+                           sampling.name + " " + std::to_string(seed) +
+                           (views > 0 ? " views " + std::to_string(views) : ""),
                        s.points);
           std::printf(
               "| %s | %zu | %s | %lu | %d, %d, %d | %zu, %zu, %ld%s | %zu | %s |\n",
@@ -213,12 +225,10 @@ main(int argc, char** argv)
         }
 
   // With views, the cases whose views left part of the surface unseen too.
-  const char* unseen_head = views > 0 ? " unseen |" : "";
   std::printf("\n| surface | cases | topology wrong | extra loops | outliers |%s\n"
               "|---|--:|--:|--:|--:|%s\n",
-              unseen_head,
+              views > 0 ? " unseen |" : "",
               views > 0 ? "--:|" : "");
-  Tally all;
   const auto row = [&](const std::string& name, const Tally& t) {
     std::printf("| %s | %zu | %zu | %zu | %zu |",
                 name.c_str(),
@@ -230,14 +240,10 @@ main(int argc, char** argv)
       std::printf(" %zu |", t.unseen);
     std::printf("\n");
   };
+  Tally all;
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
-    const Tally& t = tally[k];
-    row(surfaces[k].name, t);
-    all.cases += t.cases;
-    all.wrong += t.wrong;
-    all.extra_loops += t.extra_loops;
-    all.false_outliers += t.false_outliers;
-    all.unseen += t.unseen;
+    row(surfaces[k].name, tally[k]);
+    all += tally[k];
   }
   row("all", all);
   return 0;
