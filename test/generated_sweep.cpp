@@ -10,9 +10,11 @@
 #include <support/metrics.h>
 #include <support/surfaces.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -77,6 +79,24 @@ parseSizes(const std::string& list)
   return sizes;
 }
 
+/** \a text read whole as a number, NaN if it is not one ("0.5x" is none). */
+double
+parseNumber(const char* text)
+{
+  char* end = nullptr;
+  const double x = std::strtod(text, &end);
+  return end == text || *end != '\0' ? std::numeric_limits<double>::quiet_NaN() : x;
+}
+
+/** \a text read whole as a whole number, -1 if it is not one. */
+long
+parseWhole(const char* text)
+{
+  char* end = nullptr;
+  const long n = std::strtol(text, &end, 10);
+  return end == text || *end != '\0' ? -1 : n;
+}
+
 /** Write \a points to DIR/NAME.xyz, NAME's spaces and colons as underscores. */
 void
 writeCloud(const std::string& dir,
@@ -103,24 +123,22 @@ int
 main(int argc, char** argv)
 {
   double noise = 0.0;
-  int views = 0;
+  long views = 0, seeds = 2, threads = 1;
   std::vector<std::size_t> sizes{3000, 10000};
-  unsigned long seeds = 2;
-  int threads = 1;
   bool failures_only = false;
   std::string write_dir;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--noise" && a + 1 < argc)
-      noise = std::strtod(argv[++a], nullptr);
+      noise = parseNumber(argv[++a]);
     else if (arg == "--views" && a + 1 < argc)
-      views = std::atoi(argv[++a]);
+      views = parseWhole(argv[++a]);
     else if (arg == "--sizes" && a + 1 < argc)
       sizes = parseSizes(argv[++a]);
     else if (arg == "--seeds" && a + 1 < argc)
-      seeds = std::strtoul(argv[++a], nullptr, 10);
+      seeds = parseWhole(argv[++a]);
     else if (arg == "--threads" && a + 1 < argc)
-      threads = std::atoi(argv[++a]);
+      threads = parseWhole(argv[++a]);
     else if (arg == "--failures")
       failures_only = true;
     else if (arg == "--write" && a + 1 < argc)
@@ -128,7 +146,8 @@ main(int argc, char** argv)
     else
       sizes.clear();
   }
-  if (sizes.empty() || seeds < 1 || !(noise >= 0.0) || threads < 0 || views < 0) {
+  if (sizes.empty() || seeds < 1 || !(noise >= 0.0 && std::isfinite(noise)) ||
+      threads < 0 || views < 0) {
     std::fprintf(stderr,
                  "usage: %s [--noise S] [--views V] [--sizes N,N,...] [--seeds K] "
                  "[--threads T] [--failures] [--write DIR]\n  S: noise sigma in "
@@ -159,9 +178,9 @@ main(int argc, char** argv)
       {"even", true, 1.0}, {"random", false, 1.0}, {"even 1:8", true, 8.0}};
 
   pcl::cocone::Parameters parameters;
-  parameters.threads = threads;
+  parameters.threads = static_cast<unsigned int>(threads);
   if (views > 0)
-    std::printf("%d range views registered within half a spacing, noise sigma %.2f "
+    std::printf("%ld range views registered within half a spacing, noise sigma %.2f "
                 "spacings in each, default parameters\n\n",
                 views,
                 noise);
@@ -173,13 +192,16 @@ main(int argc, char** argv)
   for (std::size_t k = 0; k < surfaces.size(); ++k)
     for (const std::size_t n : sizes)
       for (const Sampling& sampling : samplings)
-        for (unsigned long seed = 1; seed <= seeds; ++seed) {
+        for (unsigned long seed = 1; seed <= static_cast<unsigned long>(seeds);
+             ++seed) {
           SampleOptions o = options(
               n, views > 0 ? 0.0 : noise, sampling.density_ratio, sampling.even);
           o.seed = seed;
           const Sample s =
-              views > 0 ? rangeViews(surfaces[k].make(o), views, 0.5, seed, noise)
-                        : surfaces[k].make(o);
+              views > 0
+                  ? rangeViews(
+                        surfaces[k].make(o), static_cast<int>(views), 0.5, seed, noise)
+                  : surfaces[k].make(o);
           if (s.boundary_loops < 0) { // the views leave part of it unseen
             ++tally[k].unseen;
             continue;
